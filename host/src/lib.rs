@@ -1,0 +1,1 @@
+//! margemu host library.
