@@ -1,1 +1,21 @@
-//! margemu host library.
+//! margemu host: simulates the 6-DOF test bench of Odry (2021), computes ground truth, and
+//! (in later layers) streams samples to the emulated chip and scores the device under test.
+//!
+//! Layers, bottom up:
+//! - [`scene`]: the TOML scene file, validated with errors that point at file, line and column;
+//! - [`reference`]: each joint's reference signal (steps, waypoints, sines, random, CSV);
+//! - [`bench`]: the closed-loop bench (eq. 5–17): joints, friction, PID synthesis, integrators;
+//! - [`motion`]: static, kinematic or bench motion, so a scene pays only for what it uses;
+//! - [`truth`]: ground truth of the plate (attitude, rates, specific force, field) per sample;
+//! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
+//! - [`perf`]: speed-against-error benchmarks behind `margemu bench`.
+#![warn(missing_docs)]
+
+pub mod bench;
+pub mod motion;
+pub mod output;
+pub mod perf;
+pub mod reference;
+pub mod run;
+pub mod scene;
+pub mod truth;

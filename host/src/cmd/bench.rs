@@ -1,0 +1,98 @@
+//! `margemu bench …`: speed against error, measured here and now.
+
+use anyhow::Result;
+use margemu::perf::{integrator_sweep, mode_costs};
+use margemu::scene::{Method, Scene};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+const FIGURE3: &str = include_str!("../../../hil-fixtures/scenes/figure3.toml");
+const STATIC: &str = include_str!("../../../hil-fixtures/scenes/static.toml");
+const KINEMATIC: &str = "name = \"figure3-kinematic\"\nduration = 3.0\nrate = 1000.0\nseed = 1\n\
+motion = \"kinematic\"\n[bench]\ninitial = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]\n\
+[joints.x]\ntype = \"sine\"\namplitude = 0.3\nfrequency = 1.0\noffset = 1.0\n\
+[joints.roll]\ntype = \"sine\"\namplitude = 0.4\nfrequency = 2.0\n\
+[joints.pitch]\ntype = \"sine\"\namplitude = 0.6\nfrequency = 0.5\n\
+[joints.yaw]\ntype = \"sine\"\namplitude = 0.3\nfrequency = 5.0\n";
+
+#[derive(clap::Subcommand)]
+pub enum Cmd {
+    /// Error and speed of each integrator and step on a bench scene (default: Figure 3).
+    Integrators {
+        /// A bench scene instead of the built-in Figure 3 scene.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Least wall time spent timing each row (s).
+        #[arg(long, default_value_t = 1.0)]
+        seconds: f64,
+    },
+    /// Cost per output sample of a static, a kinematic and a bench scene at 1 kHz.
+    Modes {
+        /// Least wall time spent timing each row (s).
+        #[arg(long, default_value_t = 1.0)]
+        seconds: f64,
+    },
+}
+
+fn builtin(text: &str, name: &str) -> Result<Scene> {
+    Ok(Scene::parse_str(text, Path::new(name))?)
+}
+
+impl Cmd {
+    pub fn run(self) -> Result<()> {
+        match self {
+            Cmd::Integrators { scene, seconds } => {
+                let scene = match scene {
+                    Some(p) => Scene::load(&p)?,
+                    None => builtin(FIGURE3, "figure3.toml (built in)")?,
+                };
+                let configs = [
+                    (Method::Rk4, 0.001),
+                    (Method::Rk4, 0.0005),
+                    (Method::Rk4, 0.00025),
+                    (Method::SemiImplicitEuler, 0.001),
+                    (Method::SemiImplicitEuler, 0.0005),
+                    (Method::SemiImplicitEuler, 0.0001),
+                    (Method::SemiImplicitEuler, 0.00001),
+                ];
+                let reference_step = 1e-6;
+                println!(
+                    "scene {} ({} s at {} Hz, bench dynamics + ground truth, no file output);",
+                    scene.path.display(),
+                    scene.spec.duration,
+                    scene.clock.hz()
+                );
+                println!("errors are maxima over all samples against RK4 with a {reference_step} s step\n");
+                println!(
+                    "| integrator | step (s) | max attitude error (rad) | max position error (m) | simulated s / wall s |"
+                );
+                println!("|---|---|---|---|---|");
+                let rows = integrator_sweep(&scene, &configs, reference_step, Duration::from_secs_f64(seconds));
+                for r in rows {
+                    println!(
+                        "| {:?} | {} | {:.3e} | {:.3e} | {:.0} |",
+                        r.method, r.step, r.max_attitude_error, r.max_position_error, r.realtime_factor
+                    );
+                }
+            }
+            Cmd::Modes { seconds } => {
+                let scenes = [
+                    builtin(STATIC, "static.toml (built in, 200 Hz)")?,
+                    builtin(&STATIC.replace("rate = 200.0", "rate = 1000.0"), "static.toml at 1 kHz")?,
+                    builtin(KINEMATIC, "kinematic sines")?,
+                    builtin(FIGURE3, "figure3.toml (built in)")?,
+                ];
+                println!("| scene | mode | output rate (Hz) | ns per sample | simulated s / wall s |");
+                println!("|---|---|---|---|---|");
+                let rows = mode_costs(&scenes, Duration::from_secs_f64(seconds));
+                for (r, s) in rows.iter().zip(&scenes) {
+                    println!(
+                        "| {} | {} | {} | {:.1} | {:.0} |",
+                        s.path.display(), r.mode, s.clock.hz(), r.ns_per_sample, r.realtime_factor
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+}

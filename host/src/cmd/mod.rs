@@ -1,0 +1,28 @@
+//! Subcommands of `margemu`, one file each.
+
+pub mod bench;
+pub mod scene;
+pub mod simulate;
+
+/// Every subcommand.
+#[derive(clap::Subcommand)]
+pub enum Command {
+    /// Inspect scene files.
+    #[command(subcommand)]
+    Scene(scene::Cmd),
+    /// Simulate a scene and write its run directory (truth.csv, meta.toml).
+    Simulate(simulate::Cmd),
+    /// Measure speed against error on this machine.
+    #[command(subcommand)]
+    Bench(bench::Cmd),
+}
+
+impl Command {
+    pub fn run(self) -> anyhow::Result<()> {
+        match self {
+            Command::Scene(c) => c.run(),
+            Command::Simulate(c) => c.run(),
+            Command::Bench(c) => c.run(),
+        }
+    }
+}

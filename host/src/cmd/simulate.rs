@@ -1,0 +1,52 @@
+//! `margemu simulate SCENE -o DIR`: run a scene and write its run directory.
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use margemu::scene::Scene;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+#[derive(clap::Args)]
+pub struct Cmd {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Output directory (created if missing; existing files are replaced).
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+impl Cmd {
+    pub fn run(self) -> Result<()> {
+        let scene = Scene::load(&self.scene)?;
+        let bar = ProgressBar::with_draw_target(Some(scene.samples()), ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} samples, {per_sec}, eta {eta}")
+                .expect("valid template"),
+        );
+        let start = Instant::now();
+        let mut shown = false;
+        let progress = |done, _total| {
+            // Only runs longer than a second get a bar.
+            if !shown && start.elapsed() > Duration::from_secs(1) {
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+                shown = true;
+            }
+            bar.set_position(done);
+        };
+        let summary = margemu::run::simulate_to_dir(&scene, &self.output, progress)
+            .with_context(|| format!("simulating {}", scene.path.display()))?;
+        bar.finish_and_clear();
+        println!(
+            "wrote {} samples ({} s at {} Hz) to {} in {:.2} s",
+            summary.samples,
+            scene.spec.duration,
+            scene.clock.hz(),
+            self.output.display(),
+            start.elapsed().as_secs_f64()
+        );
+        if !summary.friction_events.is_empty() {
+            println!("friction mode changes: {}", summary.friction_events.len());
+        }
+        Ok(())
+    }
+}

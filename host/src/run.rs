@@ -1,0 +1,162 @@
+//! Running a scene: samples its motion at every output instant, turns each into ground truth,
+//! and hands it to a sink ([`run`]), or writes the run directory ([`simulate_to_dir`]).
+
+use crate::bench::{pid::Design, FrictionEvent};
+use crate::motion::Motion;
+use crate::output::{TruthWriter, TRUTH_COLUMNS};
+use crate::reference::ReferenceError;
+use crate::scene::{Scene, JOINT_NAMES};
+use crate::truth::{Truth, TruthModel};
+use serde::Serialize;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// A run that failed.
+#[derive(Debug, thiserror::Error, docsplay::Display)]
+pub enum RunError {
+    /// a joint reference could not be built
+    Reference(#[from] ReferenceError),
+    /// cannot write {path}
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// What a finished run reports.
+#[derive(Clone, Debug, Default)]
+pub struct RunSummary {
+    /// Output samples produced.
+    pub samples: u64,
+    /// Friction mode changes (bench mode with static friction).
+    pub friction_events: Vec<FrictionEvent>,
+}
+
+/// Runs `scene`, calling `sink` with the truth of every output sample in time order and
+/// `progress(done, total)` every 4096 samples.
+pub fn run<E>(
+    scene: &Scene,
+    mut sink: impl FnMut(&Truth) -> Result<(), E>,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<Result<RunSummary, E>, ReferenceError> {
+    let mut motion = Motion::new(scene)?;
+    let model = TruthModel::new(scene.spec.field.reference, scene.spec.bench.gravity);
+    let total = scene.samples();
+    // A static plate's truth is the same at every instant but for the time stamp.
+    let fixed = match &motion {
+        Motion::Static(pose) => Some(model.compute(0, pose)),
+        _ => None,
+    };
+    for k in 0..total {
+        let t_ns = scene.clock.instant(k);
+        let truth = match fixed {
+            Some(truth) => Truth { t_ns, ..truth },
+            None => model.compute(t_ns, &motion.sample_at(t_ns)),
+        };
+        if let Err(e) = sink(&truth) {
+            return Ok(Err(e));
+        }
+        if k % 4096 == 4095 {
+            progress(k + 1, total);
+        }
+    }
+    progress(total, total);
+    let friction_events = motion.bench().map(|b| b.friction_log().to_vec()).unwrap_or_default();
+    Ok(Ok(RunSummary { samples: total, friction_events }))
+}
+
+/// Runs `scene` and writes `dir/meta.toml` and `dir/truth.csv` (creating `dir`).
+pub fn simulate_to_dir(
+    scene: &Scene,
+    dir: &Path,
+    progress: impl FnMut(u64, u64),
+) -> Result<RunSummary, RunError> {
+    let write_err = |path: PathBuf| move |source| RunError::Write { path, source };
+    std::fs::create_dir_all(dir).map_err(write_err(dir.to_path_buf()))?;
+    let meta_path = dir.join("meta.toml");
+    std::fs::write(&meta_path, metadata(scene)).map_err(write_err(meta_path.clone()))?;
+    let truth_path = dir.join("truth.csv");
+    let file = File::create(&truth_path).map_err(write_err(truth_path.clone()))?;
+    let mut writer =
+        TruthWriter::new(BufWriter::with_capacity(1 << 20, file)).map_err(write_err(truth_path.clone()))?;
+    let summary = run(scene, |t| writer.write(t), progress)?.map_err(write_err(truth_path.clone()))?;
+    writer.finish().map_err(write_err(truth_path))?;
+    Ok(summary)
+}
+
+#[derive(Serialize)]
+struct Meta<'a> {
+    margemu_version: &'a str,
+    scene_file: String,
+    scene_sha256: String,
+    seed: u64,
+    motion: String,
+    rate_hz: f64,
+    duration_s: f64,
+    samples: u64,
+    integrator: String,
+    integrator_step_s: f64,
+    field_unit: &'a str,
+    truth_columns: Vec<&'a str>,
+    pid: Vec<PidMeta>,
+    scene_text: &'a str,
+}
+
+#[derive(Serialize)]
+struct PidMeta {
+    joint: &'static str,
+    kp: f64,
+    ki: f64,
+    kd: f64,
+    zeta: Option<f64>,
+    natural_frequency: Option<f64>,
+    time_constant: Option<f64>,
+}
+
+/// The run's `meta.toml`: scene, its SHA-256, seed, settings, PID gains and the scene text.
+pub fn metadata(scene: &Scene) -> String {
+    let spec = &scene.spec;
+    let designs = crate::bench::designs(scene);
+    let pid = JOINT_NAMES
+        .iter()
+        .enumerate()
+        .map(|(i, joint)| {
+            let d: Option<&Design> = designs[i].as_ref();
+            let [kp, ki, kd] = match (&spec.control.gains, d) {
+                (Some(g), _) => g[i],
+                (None, Some(d)) => [d.gains.kp, d.gains.ki, d.gains.kd],
+                (None, None) => [f64::NAN; 3],
+            };
+            PidMeta {
+                joint,
+                kp,
+                ki,
+                kd,
+                zeta: d.map(|d| d.tuned.0),
+                natural_frequency: d.map(|d| d.tuned.1),
+                time_constant: d.map(|d| d.time_constant),
+            }
+        })
+        .collect();
+    let meta = Meta {
+        margemu_version: env!("CARGO_PKG_VERSION"),
+        scene_file: scene.path.display().to_string(),
+        scene_sha256: scene.hash(),
+        seed: spec.seed,
+        motion: format!("{:?}", spec.motion).to_lowercase(),
+        rate_hz: scene.clock.hz(),
+        duration_s: spec.duration,
+        samples: scene.samples(),
+        integrator: format!("{:?}", spec.integrator.method),
+        integrator_step_s: spec.integrator.step,
+        field_unit: spec.field.unit.symbol(),
+        truth_columns: TRUTH_COLUMNS.to_vec(),
+        pid,
+        scene_text: &scene.text,
+    };
+    toml::to_string(&meta).expect("metadata serializes")
+}

@@ -1,0 +1,142 @@
+//! Scene errors that point at the file, line and column.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Why a scene was refused, and where.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneError {
+    /// The scene file.
+    pub file: PathBuf,
+    /// 1-based line and column of the offending text, when it has a place in the file.
+    pub position: Option<(usize, usize)>,
+    /// What is wrong.
+    pub reason: String,
+}
+
+impl std::error::Error for SceneError {}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.position {
+            Some((line, col)) => write!(f, "{}:{line}:{col}: {}", self.file.display(), self.reason),
+            None => write!(f, "{}: {}", self.file.display(), self.reason),
+        }
+    }
+}
+
+/// A validation failure: the key path of the offending value and the reason.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Violation {
+    pub path: Vec<PathPart>,
+    pub reason: String,
+}
+
+/// One step of a key path: a table key or an array index.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum PathPart {
+    Key(String),
+    Index(usize),
+}
+
+impl Violation {
+    pub fn at(path: &[&str], reason: impl Into<String>) -> Self {
+        Self {
+            path: path.iter().map(|k| PathPart::Key((*k).to_owned())).collect(),
+            reason: reason.into(),
+        }
+    }
+
+    pub fn index(mut self, i: usize) -> Self {
+        self.path.push(PathPart::Index(i));
+        self
+    }
+
+    fn dotted(&self) -> String {
+        let mut s = String::new();
+        for part in &self.path {
+            match part {
+                PathPart::Key(k) if s.is_empty() => s.push_str(k),
+                PathPart::Key(k) => {
+                    s.push('.');
+                    s.push_str(k)
+                }
+                PathPart::Index(i) => s.push_str(&format!("[{i}]")),
+            }
+        }
+        s
+    }
+}
+
+impl SceneError {
+    pub(crate) fn io(path: &Path, e: &std::io::Error) -> Self {
+        Self { file: path.to_path_buf(), position: None, reason: format!("cannot read: {e}") }
+    }
+
+    pub(crate) fn from_toml(path: &Path, text: &str, e: &toml::de::Error) -> Self {
+        let position = e.span().map(|s| line_col(text, s.start));
+        Self { file: path.to_path_buf(), position, reason: e.message().trim().to_owned() }
+    }
+
+    pub(crate) fn from_violation(path: &Path, text: &str, v: Violation) -> Self {
+        let span = locate(text, &v.path);
+        let reason = if v.path.is_empty() {
+            v.reason.clone()
+        } else {
+            format!("`{}`: {}", v.dotted(), v.reason)
+        };
+        Self { file: path.to_path_buf(), position: span.map(|s| line_col(text, s)), reason }
+    }
+}
+
+/// 1-based line and column (in characters) of byte offset `at`.
+fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let at = at.min(text.len());
+    let before = text.get(..at).unwrap_or(text);
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+/// Byte offset of the value at `path`, or of its nearest ancestor that is in the file.
+fn locate(text: &str, path: &[PathPart]) -> Option<usize> {
+    let doc = toml_edit::Document::parse(text).ok()?;
+    let mut item: &toml_edit::Item = doc.as_item();
+    let mut best = None;
+    for part in path {
+        let next = match part {
+            PathPart::Key(k) => item.get(k.as_str()),
+            PathPart::Index(i) => item.get(*i),
+        };
+        let Some(next) = next else { break };
+        item = next;
+        if let Some(span) = item.span() {
+            best = Some(span.start);
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_and_column_are_one_based() {
+        let text = "a = 1\nbb = 2\n";
+        assert_eq!(line_col(text, 0), (1, 1));
+        assert_eq!(line_col(text, 6), (2, 1));
+        assert_eq!(line_col(text, 11), (2, 6));
+    }
+
+    #[test]
+    fn values_are_located_by_key_path() {
+        let text = "x = 1\n[bench]\nplate_mass = -2.0\ninitial = [0, 1, 2]\n";
+        let v = Violation::at(&["bench", "plate_mass"], "must be positive");
+        assert_eq!(locate(text, &v.path).map(|at| line_col(text, at)), Some((3, 14)));
+        let v = Violation::at(&["bench", "initial"], "bad").index(2);
+        assert_eq!(locate(text, &v.path).map(|at| line_col(text, at)), Some((4, 18)));
+        let missing = Violation::at(&["bench", "nothing"], "absent");
+        assert_eq!(locate(text, &missing.path).map(|at| line_col(text, at)), Some((2, 1)));
+    }
+}

@@ -1,0 +1,247 @@
+//! Semantic checks of a parsed scene: every value finite and in range, the run a whole number of
+//! integrator steps, and each joint's source allowed in the scene's motion mode.
+
+use super::error::Violation;
+use super::schema::*;
+use margemu_model::time::{nanos_from_seconds, Nanos, SampleClock};
+use std::path::Path;
+
+/// What validation derives on the way.
+pub(crate) struct Checked {
+    pub clock: SampleClock,
+    pub duration_ns: Nanos,
+    pub step_ns: Nanos,
+}
+
+type Check = Result<(), Violation>;
+
+pub(crate) fn check(spec: &SceneSpec, _path: &Path) -> Result<Checked, Violation> {
+    let duration_ns = positive_nanos(spec.duration, &["duration"])?;
+    finite_positive(spec.rate, &["rate"])?;
+    let clock = SampleClock::from_hz(spec.rate)
+        .ok_or_else(|| Violation::at(&["rate"], "must be between 0.001 Hz and 1 GHz"))?;
+    let step_ns = positive_nanos(spec.integrator.step, &["integrator", "step"])?;
+    if duration_ns % step_ns != 0 {
+        return Err(Violation::at(
+            &["duration"],
+            format!(
+                "{} s is not a whole number of integrator steps of {} s",
+                spec.duration, spec.integrator.step
+            ),
+        ));
+    }
+    if clock.count_before(duration_ns) == 0 {
+        return Err(Violation::at(&["duration"], "shorter than one output sample"));
+    }
+    all_finite(&spec.field.reference, &["field", "reference"])?;
+    check_bench(&spec.bench)?;
+    check_control(&spec.control)?;
+    for (name, source) in &spec.joints {
+        check_joint(name, source, spec.motion)?;
+    }
+    Ok(Checked { clock, duration_ns, step_ns })
+}
+
+fn check_bench(b: &BenchSpec) -> Check {
+    all_positive(&b.link_mass, &["bench", "link_mass"], "a mass")?;
+    finite_positive(b.plate_mass, &["bench", "plate_mass"])?;
+    all_positive(&b.plate_inertia, &["bench", "plate_inertia"], "an inertia")?;
+    all_non_negative(&b.viscous_friction, &["bench", "viscous_friction"])?;
+    all_non_negative(&b.static_friction, &["bench", "static_friction"])?;
+    if let Some(limit) = &b.effort_limit {
+        all_positive(limit, &["bench", "effort_limit"], "an effort limit")?;
+    }
+    all_finite(&b.initial, &["bench", "initial"])?;
+    if !(b.gravity.is_finite() && b.gravity >= 0.0) {
+        return Err(Violation::at(&["bench", "gravity"], "must be finite and ≥ 0"));
+    }
+    Ok(())
+}
+
+fn check_control(c: &ControlSpec) -> Check {
+    for (i, &o) in c.overshoot.iter().enumerate() {
+        if !(o.is_finite() && o > 0.0 && o < 1.0) {
+            return Err(Violation::at(&["control", "overshoot"], "must be in (0, 1)").index(i));
+        }
+    }
+    all_positive(&c.settling_time, &["control", "settling_time"], "a settling time")?;
+    if !(c.pole_ratio.is_finite() && c.pole_ratio >= 1.0) {
+        return Err(Violation::at(&["control", "pole_ratio"], "must be finite and ≥ 1"));
+    }
+    if !(c.retune_margin.is_finite() && c.retune_margin > 0.0 && c.retune_margin <= 1.0) {
+        return Err(Violation::at(&["control", "retune_margin"], "must be in (0, 1]"));
+    }
+    if let Some(gains) = &c.gains {
+        for (i, g) in gains.iter().enumerate() {
+            all_finite(g, &["control", "gains"]).map_err(|v| v.index(i))?;
+        }
+    }
+    finite_positive(c.external_acceleration, &["control", "external_acceleration"])?;
+    finite_positive(c.oscillation_rate, &["control", "oscillation_rate"])?;
+    Ok(())
+}
+
+fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
+    let at = ["joints", name];
+    if !JOINT_NAMES.contains(&name) {
+        return Err(Violation::at(
+            &at,
+            format!("unknown joint; the joints are {}", JOINT_NAMES.join(", ")),
+        ));
+    }
+    match motion {
+        MotionMode::Static => {
+            return Err(Violation::at(&at, "a static scene takes no joint sources"));
+        }
+        MotionMode::Kinematic if !source.is_kinematic() || source.smoothing().is_some() => {
+            return Err(Violation::at(
+                &["joints", name, "type"],
+                format!(
+                    "`{}`{} cannot prescribe motion directly (kinematic mode needs twice \
+                     differentiable sources: constant, sine, polynomial, random-sine, csv)",
+                    source.type_name(),
+                    if source.smoothing().is_some() { " with smoothing" } else { "" }
+                ),
+            ));
+        }
+        _ => {}
+    }
+    if let Some(s) = source.smoothing() {
+        let at = ["joints", name, "smoothing"];
+        finite_positive(s.natural_frequency, &[at[0], at[1], at[2], "natural_frequency"])?;
+        finite_positive(s.damping, &[at[0], at[1], at[2], "damping"])?;
+    }
+    let key = |k: &'static str| [at[0], at[1], k];
+    match source {
+        SourceSpec::Constant { value } => finite(*value, &key("value")),
+        SourceSpec::Steps { points, .. } => {
+            non_empty(points, &key("points"))?;
+            let mut last = f64::NEG_INFINITY;
+            for (i, &[t, v]) in points.iter().enumerate() {
+                let entry = |k, why| Violation::at(&key("points"), why).index(i).index(k);
+                if !(t.is_finite() && t >= 0.0 && t > last) {
+                    return Err(entry(0, "times must be finite, ≥ 0 and increasing"));
+                }
+                if !v.is_finite() {
+                    return Err(entry(1, "must be finite"));
+                }
+                last = t;
+            }
+            Ok(())
+        }
+        SourceSpec::Waypoints { points, .. } => {
+            non_empty(points, &key("points"))?;
+            for (i, &[v, hold]) in points.iter().enumerate() {
+                let entry = |k, why| Violation::at(&key("points"), why).index(i).index(k);
+                if !v.is_finite() {
+                    return Err(entry(0, "must be finite"));
+                }
+                if !(hold.is_finite() && hold > 0.0) {
+                    return Err(entry(1, "hold must be finite and > 0"));
+                }
+            }
+            Ok(())
+        }
+        SourceSpec::Sine { amplitude, frequency, phase, offset } => {
+            finite(*amplitude, &key("amplitude"))?;
+            non_negative(*frequency, &key("frequency"))?;
+            finite(*phase, &key("phase"))?;
+            finite(*offset, &key("offset"))
+        }
+        SourceSpec::Polynomial { coefficients } => {
+            non_empty(coefficients, &key("coefficients"))?;
+            all_finite(coefficients, &key("coefficients"))
+        }
+        SourceSpec::RandomSetpoints { range, hold, .. } => {
+            interval(range, &key("range"), false)?;
+            interval(hold, &key("hold"), true)
+        }
+        SourceSpec::RandomSine { amplitude, frequency, segment, offset } => {
+            interval(amplitude, &key("amplitude"), false)?;
+            interval(frequency, &key("frequency"), true)?;
+            interval(segment, &key("segment"), true)?;
+            finite(*offset, &key("offset"))
+        }
+        SourceSpec::Csv { column, .. } => {
+            if column.is_empty() {
+                return Err(Violation::at(&key("column"), "must name a column"));
+            }
+            Ok(())
+        }
+    }
+}
+
+fn positive_nanos(s: f64, at: &[&str]) -> Result<Nanos, Violation> {
+    finite_positive(s, at)?;
+    match nanos_from_seconds(s) {
+        Some(ns) if ns > 0 => Ok(ns),
+        _ => Err(Violation::at(at, "must be at least 1 ns and at most 584 years")),
+    }
+}
+
+fn finite(x: f64, at: &[&str]) -> Check {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        Err(Violation::at(at, format!("must be finite, not {x}")))
+    }
+}
+
+fn finite_positive(x: f64, at: &[&str]) -> Check {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(Violation::at(at, format!("must be finite and > 0, not {x}")))
+    }
+}
+
+fn non_negative(x: f64, at: &[&str]) -> Check {
+    if x.is_finite() && x >= 0.0 {
+        Ok(())
+    } else {
+        Err(Violation::at(at, format!("must be finite and ≥ 0, not {x}")))
+    }
+}
+
+fn all_finite(xs: &[f64], at: &[&str]) -> Check {
+    for (i, x) in xs.iter().enumerate() {
+        finite(*x, at).map_err(|v| v.index(i))?;
+    }
+    Ok(())
+}
+
+fn all_positive(xs: &[f64], at: &[&str], what: &str) -> Check {
+    for (i, &x) in xs.iter().enumerate() {
+        if !(x.is_finite() && x > 0.0) {
+            return Err(Violation::at(at, format!("{what} must be finite and > 0, not {x}")).index(i));
+        }
+    }
+    Ok(())
+}
+
+fn all_non_negative(xs: &[f64], at: &[&str]) -> Check {
+    for (i, x) in xs.iter().enumerate() {
+        non_negative(*x, at).map_err(|v| v.index(i))?;
+    }
+    Ok(())
+}
+
+fn non_empty<T>(xs: &[T], at: &[&str]) -> Check {
+    if xs.is_empty() {
+        Err(Violation::at(at, "must not be empty"))
+    } else {
+        Ok(())
+    }
+}
+
+/// `[lo, hi]` finite with `lo ≤ hi`; `positive` also asks `lo > 0`.
+fn interval(r: &[f64; 2], at: &[&str], positive: bool) -> Check {
+    all_finite(r, at)?;
+    if r[0] > r[1] {
+        return Err(Violation::at(at, format!("[lo, hi] must have lo ≤ hi, not {r:?}")));
+    }
+    if positive && r[0] <= 0.0 {
+        return Err(Violation::at(at, "must be > 0").index(0));
+    }
+    Ok(())
+}
