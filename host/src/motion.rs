@@ -26,17 +26,23 @@ impl Motion {
     pub fn new(scene: &Scene) -> Result<Self, ReferenceError> {
         let spec = &scene.spec;
         Ok(match spec.motion {
-            MotionMode::Static => {
-                Motion::Static(JointSample { q: spec.bench.initial, ..JointSample::default() })
-            }
+            MotionMode::Static => Motion::Static(JointSample {
+                q: spec.bench.initial,
+                ..JointSample::default()
+            }),
             MotionMode::Kinematic => {
                 let mut refs = Vec::with_capacity(6);
                 for (i, name) in JOINT_NAMES.iter().enumerate() {
                     let initial = spec.bench.initial[i];
                     refs.push(match spec.joints.get(*name) {
-                        Some(source) => {
-                            Reference::build(source, name, initial, spec.seed, scene.base_dir(), true)?
-                        }
+                        Some(source) => Reference::build(
+                            source,
+                            name,
+                            initial,
+                            spec.seed,
+                            scene.base_dir(),
+                            true,
+                        )?,
                         None => Reference::constant(initial),
                     });
                 }

@@ -39,7 +39,10 @@ impl<W: Write> TruthWriter<W> {
     /// Writes the header and returns the writer.
     pub fn new(mut out: W) -> io::Result<Self> {
         writeln!(out, "{}", TRUTH_COLUMNS.join(","))?;
-        Ok(Self { out, float: ryu::Buffer::new() })
+        Ok(Self {
+            out,
+            float: ryu::Buffer::new(),
+        })
     }
 
     /// Writes one row.
@@ -78,12 +81,20 @@ mod tests {
     #[test]
     fn rows_have_as_many_fields_as_the_header() {
         let mut w = TruthWriter::new(Vec::new()).unwrap();
-        let truth = Truth { t_ns: 5, quaternion: [1.0, 0.0, 0.0, 0.0], ..Truth::default() };
+        let truth = Truth {
+            t_ns: 5,
+            quaternion: [1.0, 0.0, 0.0, 0.0],
+            ..Truth::default()
+        };
         w.write(&truth).unwrap();
         let text = String::from_utf8(w.finish().unwrap()).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 2);
         assert_eq!(lines[1].split(',').count(), TRUTH_COLUMNS.len());
-        assert!(lines[1].starts_with("5,0.0,0.0,0.0,0.0,0.0,0.0,1.0,"), "{}", lines[1]);
+        assert!(
+            lines[1].starts_with("5,0.0,0.0,0.0,0.0,0.0,0.0,1.0,"),
+            "{}",
+            lines[1]
+        );
     }
 }

@@ -56,7 +56,9 @@ fn trajectory(scene: &Scene) -> Vec<([f64; 4], [f64; 3])> {
         out.push((t.quaternion, t.position));
         Ok(())
     };
-    run(scene, sink, |_, _| {}).expect("scene builds").expect("sink never fails");
+    run(scene, sink, |_, _| {})
+        .expect("scene builds")
+        .expect("sink never fails");
     out
 }
 
@@ -64,7 +66,9 @@ fn trajectory(scene: &Scene) -> Vec<([f64; 4], [f64; 3])> {
 /// returns wall seconds per run. One untimed run first warms caches and the per-process PID
 /// synthesis memo, so the figure is the steady per-sample cost.
 pub fn time_run(scene: &Scene, min_wall: Duration) -> f64 {
-    run(scene, |_| Ok::<(), ()>(()), |_, _| {}).expect("scene builds").expect("sink never fails");
+    run(scene, |_| Ok::<(), ()>(()), |_, _| {})
+        .expect("scene builds")
+        .expect("sink never fails");
     let mut runs = 0u32;
     let start = Instant::now();
     while runs == 0 || start.elapsed() < min_wall {
@@ -73,7 +77,9 @@ pub fn time_run(scene: &Scene, min_wall: Duration) -> f64 {
             acc += t.quaternion[0] + t.specific_force[2];
             Ok(())
         };
-        run(scene, sink, |_, _| {}).expect("scene builds").expect("sink never fails");
+        run(scene, sink, |_, _| {})
+            .expect("scene builds")
+            .expect("sink never fails");
         black_box(acc);
         runs += 1;
     }
@@ -118,7 +124,11 @@ pub fn mode_costs(scenes: &[Scene], min_wall: Duration) -> Vec<ModeRow> {
         .map(|s| {
             let wall = time_run(s, min_wall);
             ModeRow {
-                name: s.spec.name.clone().unwrap_or_else(|| s.path.display().to_string()),
+                name: s
+                    .spec
+                    .name
+                    .clone()
+                    .unwrap_or_else(|| s.path.display().to_string()),
                 mode: format!("{:?}", s.spec.motion).to_lowercase(),
                 ns_per_sample: wall * 1e9 / s.samples() as f64,
                 realtime_factor: s.spec.duration / wall,

@@ -65,8 +65,14 @@ pub fn run<E>(
         }
     }
     progress(total, total);
-    let friction_events = motion.bench().map(|b| b.friction_log().to_vec()).unwrap_or_default();
-    Ok(Ok(RunSummary { samples: total, friction_events }))
+    let friction_events = motion
+        .bench()
+        .map(|b| b.friction_log().to_vec())
+        .unwrap_or_default();
+    Ok(Ok(RunSummary {
+        samples: total,
+        friction_events,
+    }))
 }
 
 /// Runs `scene` and writes `dir/meta.toml` and `dir/truth.csv` (creating `dir`).
@@ -81,9 +87,10 @@ pub fn simulate_to_dir(
     std::fs::write(&meta_path, metadata(scene)).map_err(write_err(meta_path.clone()))?;
     let truth_path = dir.join("truth.csv");
     let file = File::create(&truth_path).map_err(write_err(truth_path.clone()))?;
-    let mut writer =
-        TruthWriter::new(BufWriter::with_capacity(1 << 20, file)).map_err(write_err(truth_path.clone()))?;
-    let summary = run(scene, |t| writer.write(t), progress)?.map_err(write_err(truth_path.clone()))?;
+    let mut writer = TruthWriter::new(BufWriter::with_capacity(1 << 20, file))
+        .map_err(write_err(truth_path.clone()))?;
+    let summary =
+        run(scene, |t| writer.write(t), progress)?.map_err(write_err(truth_path.clone()))?;
     writer.finish().map_err(write_err(truth_path))?;
     Ok(summary)
 }

@@ -60,7 +60,10 @@ pub struct TruthModel {
 impl TruthModel {
     /// A model for the world-frame field `field_world` and gravity `gravity` (m/s²).
     pub fn new(field_world: [f64; 3], gravity: f64) -> Self {
-        Self { field_world: Vector3::from(field_world), gravity }
+        Self {
+            field_world: Vector3::from(field_world),
+            gravity,
+        }
     }
 
     /// Ground truth at `t_ns` for the joint sample `s`.
@@ -79,9 +82,15 @@ impl TruthModel {
         let (st, ct) = (2.0 * st2 * ct2, ct2 * ct2 - st2 * st2);
         let (ss, cs) = (2.0 * ss2 * cs2, cs2 * cs2 - ss2 * ss2);
         let r = Matrix3::new(
-            cs * ct, cs * st * sp - ss * cp, cs * st * cp + ss * sp,
-            ss * ct, ss * st * sp + cs * cp, ss * st * cp - cs * sp,
-            -st, ct * sp, ct * cp,
+            cs * ct,
+            cs * st * sp - ss * cp,
+            cs * st * cp + ss * sp,
+            ss * ct,
+            ss * st * sp + cs * cp,
+            ss * st * cp - cs * sp,
+            -st,
+            ct * sp,
+            ct * cp,
         );
         let [dphi, dtheta, dpsi] = [s.qd[3], s.qd[4], s.qd[5]];
         let [ddphi, ddtheta, ddpsi] = [s.qdd[3], s.qdd[4], s.qdd[5]];
@@ -94,7 +103,8 @@ impl TruthModel {
             ddphi - ddpsi * st - dpsi * dtheta * ct,
             ddtheta * cp - dtheta * dphi * sp + ddpsi * ct * sp - dpsi * dtheta * st * sp
                 + dpsi * dphi * ct * cp,
-            -ddtheta * sp - dtheta * dphi * cp + ddpsi * ct * cp - dpsi * dtheta * st * cp
+            -ddtheta * sp - dtheta * dphi * cp + ddpsi * ct * cp
+                - dpsi * dtheta * st * cp
                 - dpsi * dphi * ct * sp,
         ];
         let accel_world = Vector3::new(s.qdd[0], s.qdd[1], s.qdd[2]);

@@ -91,7 +91,11 @@ impl LinearStep {
     fn apply(&self, x: &State, r: [f64; 3]) -> State {
         std::array::from_fn(|i| {
             let row = &self.phi[i];
-            row[0] * x[0] + row[1] * x[1] + row[2] * x[2] + row[3] * x[3] + row[4] * x[4]
+            row[0] * x[0]
+                + row[1] * x[1]
+                + row[2] * x[2]
+                + row[3] * x[3]
+                + row[4] * x[4]
                 + self.g[0][i] * r[0]
                 + self.g[1][i] * r[1]
                 + self.g[2][i] * r[2]
@@ -112,7 +116,12 @@ impl Joint {
     /// A joint at rest at `q0`, stuck if it has static friction.
     pub fn new(params: JointParams, q0: f64, r0: f64) -> Self {
         let state = [q0, 0.0, 0.0, r0, 0.0];
-        Self { params, state, stuck: params.stiction > 0.0, linear: None }
+        Self {
+            params,
+            state,
+            stuck: params.stiction > 0.0,
+            linear: None,
+        }
     }
 
     /// Whether the joint is linear (no stiction, no effort limit).
@@ -127,7 +136,11 @@ impl Joint {
             return;
         }
         let probe = |x: State, r: [f64; 3]| {
-            let j = Joint { state: x, linear: None, ..self.clone() };
+            let j = Joint {
+                state: x,
+                linear: None,
+                ..self.clone()
+            };
             j.advance(method, h, r)
         };
         let unit = |i: usize| -> State { std::array::from_fn(|k| if k == i { 1.0 } else { 0.0 }) };
@@ -201,7 +214,11 @@ impl Joint {
         } else {
             (s[V], (effort.net - p.viscous * s[V]) / p.mass)
         };
-        let di = if effort.hold_integral { 0.0 } else { effort.error };
+        let di = if effort.hold_integral {
+            0.0
+        } else {
+            effort.error
+        };
         let (drf, drfd) = match p.smoothing {
             Some((wn, zeta)) => (s[RFD], wn * wn * (r - s[RF]) - 2.0 * zeta * wn * s[RFD]),
             None => (0.0, 0.0),
@@ -278,7 +295,11 @@ mod tests {
             stiction,
             load: 0.0,
             limit: f64::INFINITY,
-            gains: Gains { kp: 0.0, ki: 10.0, kd: 0.0 },
+            gains: Gains {
+                kp: 0.0,
+                ki: 10.0,
+                kd: 0.0,
+            },
             smoothing: None,
         }
     }
@@ -315,7 +336,11 @@ mod tests {
     #[test]
     fn the_linear_step_map_is_the_same_method() {
         let mut p = params(0.0);
-        p.gains = Gains { kp: 30.0, ki: 40.0, kd: 5.0 };
+        p.gains = Gains {
+            kp: 30.0,
+            ki: 40.0,
+            kd: 5.0,
+        };
         p.smoothing = Some((46.0, 0.869));
         for method in [Method::Rk4, Method::SemiImplicitEuler] {
             let mut general = Joint::new(p, 0.1, 0.1);
@@ -330,7 +355,10 @@ mod tests {
             }
             for i in 0..5 {
                 let (a, b) = (general.state[i], fast.state[i]);
-                assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs()), "{method:?} state {i}: {a} vs {b}");
+                assert!(
+                    (a - b).abs() <= 1e-12 * (1.0 + a.abs()),
+                    "{method:?} state {i}: {a} vs {b}"
+                );
             }
             // A nonlinear joint keeps the general path.
             let mut stuck = Joint::new(params(1.0), 0.0, 0.0);

@@ -86,8 +86,17 @@ pub fn designs(scene: &Scene) -> [Option<Design>; 6] {
     let (masses, _) = masses_and_loads(scene);
     let friction = scene.spec.bench.viscous_friction;
     std::array::from_fn(|i| {
-        let req = Requirement { overshoot: c.overshoot[i], settling_time: c.settling_time[i] };
-        Some(pid::synthesize(masses[i], friction[i], req, c.pole_ratio, c.retune.then_some(c.retune_margin)))
+        let req = Requirement {
+            overshoot: c.overshoot[i],
+            settling_time: c.settling_time[i],
+        };
+        Some(pid::synthesize(
+            masses[i],
+            friction[i],
+            req,
+            c.pole_ratio,
+            c.retune.then_some(c.retune_margin),
+        ))
     })
 }
 
@@ -101,14 +110,20 @@ impl Bench {
         for (i, name) in JOINT_NAMES.iter().enumerate() {
             let initial = spec.bench.initial[i];
             references.push(match spec.joints.get(*name) {
-                Some(source) => Reference::build(source, name, initial, spec.seed, scene.base_dir(), false)?,
+                Some(source) => {
+                    Reference::build(source, name, initial, spec.seed, scene.base_dir(), false)?
+                }
                 None => Reference::constant(initial),
             });
         }
         let references: [Reference; 6] = references.try_into().expect("six joints");
         let joints = std::array::from_fn(|i| {
             let gains = match (&spec.control.gains, &designs[i]) {
-                (Some(g), _) => Gains { kp: g[i][0], ki: g[i][1], kd: g[i][2] },
+                (Some(g), _) => Gains {
+                    kp: g[i][0],
+                    ki: g[i][1],
+                    kd: g[i][2],
+                },
                 (None, Some(d)) => d.gains,
                 (None, None) => unreachable!("designs exist when gains are not given"),
             };
@@ -179,15 +194,22 @@ impl Bench {
     fn step(&mut self, end: Nanos) {
         let (t0, t1) = (self.t_ns as f64, end as f64);
         let h = (end - self.t_ns) as f64 * 1e-9;
-        for (i, (joint, reference)) in self.joints.iter_mut().zip(&mut self.references).enumerate() {
+        for (i, (joint, reference)) in self.joints.iter_mut().zip(&mut self.references).enumerate()
+        {
             let r = match self.method {
-                Method::Rk4 => {
-                    [reference.value(t0), reference.value(0.5 * (t0 + t1)), reference.value_before(t1)]
-                }
+                Method::Rk4 => [
+                    reference.value(t0),
+                    reference.value(0.5 * (t0 + t1)),
+                    reference.value_before(t1),
+                ],
                 Method::SemiImplicitEuler => [reference.value(t0); 3],
             };
             if let Some(change) = joint.step(self.method, h, r) {
-                self.friction_log.push(FrictionEvent { t_ns: end, joint: i, change });
+                self.friction_log.push(FrictionEvent {
+                    t_ns: end,
+                    joint: i,
+                    change,
+                });
             }
         }
         self.t_ns = end;

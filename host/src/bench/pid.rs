@@ -105,7 +105,11 @@ fn normalized_design(overshoot: f64, pole_ratio: f64, margin: Option<f64>) -> (f
     use std::sync::{Mutex, OnceLock};
     type Key = (u64, u64, Option<u64>);
     static MEMO: OnceLock<Mutex<HashMap<Key, (f64, f64, f64)>>> = OnceLock::new();
-    let key = (overshoot.to_bits(), pole_ratio.to_bits(), margin.map(f64::to_bits));
+    let key = (
+        overshoot.to_bits(),
+        pole_ratio.to_bits(),
+        margin.map(f64::to_bits),
+    );
     let memo = MEMO.get_or_init(Default::default);
     if let Some(hit) = memo.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
         return *hit;
@@ -116,7 +120,9 @@ fn normalized_design(overshoot: f64, pole_ratio: f64, margin: Option<f64>) -> (f
         Some(m) => smallest_damping(zeta0, pole_ratio, m * overshoot),
     };
     let (os, ts) = normalized_step(zeta, pole_ratio);
-    memo.lock().unwrap_or_else(|e| e.into_inner()).insert(key, (zeta, os, ts));
+    memo.lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(key, (zeta, os, ts));
     (zeta, os, ts)
 }
 
@@ -200,7 +206,10 @@ mod tests {
 
     #[test]
     fn the_zero_of_eq14_raises_overshoot_and_retuning_restores_it() {
-        let req = Requirement { overshoot: 0.2, settling_time: 1.0 };
+        let req = Requirement {
+            overshoot: 0.2,
+            settling_time: 1.0,
+        };
         let plain = synthesize(500.2, 100.0, req, 10.0, None);
         assert!(plain.predicted_overshoot > 0.3, "{plain:?}");
         let tuned = synthesize(500.2, 100.0, req, 10.0, Some(0.9));

@@ -67,28 +67,46 @@ impl Cmd {
                     "| integrator | step (s) | max attitude error (rad) | max position error (m) | simulated s / wall s |"
                 );
                 println!("|---|---|---|---|---|");
-                let rows = integrator_sweep(&scene, &configs, reference_step, Duration::from_secs_f64(seconds));
+                let rows = integrator_sweep(
+                    &scene,
+                    &configs,
+                    reference_step,
+                    Duration::from_secs_f64(seconds),
+                );
                 for r in rows {
                     println!(
                         "| {:?} | {} | {:.3e} | {:.3e} | {:.0} |",
-                        r.method, r.step, r.max_attitude_error, r.max_position_error, r.realtime_factor
+                        r.method,
+                        r.step,
+                        r.max_attitude_error,
+                        r.max_position_error,
+                        r.realtime_factor
                     );
                 }
             }
             Cmd::Modes { seconds } => {
                 let scenes = [
                     builtin(STATIC, "static.toml (built in, 200 Hz)")?,
-                    builtin(&STATIC.replace("rate = 200.0", "rate = 1000.0"), "static.toml at 1 kHz")?,
+                    builtin(
+                        &STATIC.replace("rate = 200.0", "rate = 1000.0"),
+                        "static.toml at 1 kHz",
+                    )?,
                     builtin(KINEMATIC, "kinematic sines")?,
                     builtin(FIGURE3, "figure3.toml (built in)")?,
                 ];
-                println!("| scene | mode | output rate (Hz) | ns per sample | simulated s / wall s |");
+                println!(
+                    "| scene | mode | output rate (Hz) | ns per sample | simulated s / wall s |"
+                );
                 println!("|---|---|---|---|---|");
                 let rows = mode_costs(&scenes, Duration::from_secs_f64(seconds));
                 for (r, s) in rows.iter().zip(&scenes) {
                     println!(
                         "| {} | {} | {} | {:.1} | {:.0} |",
-                        s.path.display(), r.mode, s.clock.hz(), r.ns_per_sample, r.realtime_factor
+                        s.path.display(),
+                        r.mode,
+                        s.clock.hz(),
+                        r.ns_per_sample,
+                        r.realtime_factor
                     );
                 }
             }

@@ -37,7 +37,10 @@ impl Cmd {
         }
         let (masses, _) = masses_and_loads(&scene);
         if let Some(gains) = &spec.control.gains {
-            println!("{:<6} {:>12} {:>12} {:>12}   (explicit gains)", "joint", "Kp", "Ki", "Kd");
+            println!(
+                "{:<6} {:>12} {:>12} {:>12}   (explicit gains)",
+                "joint", "Kp", "Ki", "Kd"
+            );
             for (name, g) in JOINT_NAMES.iter().zip(gains) {
                 println!("{name:<6} {:>12.6} {:>12.6} {:>12.6}", g[0], g[1], g[2]);
             }
@@ -45,7 +48,18 @@ impl Cmd {
         }
         println!(
             "{:<6} {:>10} {:>6} {:>7} {:>6} {:>7} {:>8} {:>12} {:>12} {:>12} {:>9} {:>9}",
-            "joint", "M", "ζ eq11", "ωn eq11", "ζ", "ωn", "T (s)", "Kp", "Ki", "Kd", "overshoot", "settling"
+            "joint",
+            "M",
+            "ζ eq11",
+            "ωn eq11",
+            "ζ",
+            "ωn",
+            "T (s)",
+            "Kp",
+            "Ki",
+            "Kd",
+            "overshoot",
+            "settling"
         );
         for (i, d) in designs(&scene).iter().enumerate() {
             let d = d.as_ref().expect("synthesised");

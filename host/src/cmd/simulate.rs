@@ -18,7 +18,8 @@ pub struct Cmd {
 impl Cmd {
     pub fn run(self) -> Result<()> {
         let scene = Scene::load(&self.scene)?;
-        let bar = ProgressBar::with_draw_target(Some(scene.samples()), ProgressDrawTarget::hidden());
+        let bar =
+            ProgressBar::with_draw_target(Some(scene.samples()), ProgressDrawTarget::hidden());
         bar.set_style(
             ProgressStyle::with_template("{bar:40} {pos}/{len} samples, {per_sec}, eta {eta}")
                 .expect("valid template"),

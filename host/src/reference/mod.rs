@@ -51,7 +51,12 @@ pub struct Reference {
 #[derive(Clone, Debug)]
 enum Kind {
     Constant(f64),
-    Sine { amplitude: f64, omega: f64, phase: f64, offset: f64 },
+    Sine {
+        amplitude: f64,
+        omega: f64,
+        phase: f64,
+        offset: f64,
+    },
     Polynomial(Vec<f64>),
     Piecewise(Piecewise),
     Linear(Table),
@@ -72,7 +77,12 @@ impl Reference {
     ) -> Result<Self, ReferenceError> {
         let kind = match spec {
             SourceSpec::Constant { value } => Kind::Constant(*value),
-            SourceSpec::Sine { amplitude, frequency, phase, offset } => Kind::Sine {
+            SourceSpec::Sine {
+                amplitude,
+                frequency,
+                phase,
+                offset,
+            } => Kind::Sine {
                 amplitude: *amplitude,
                 omega: 2.0 * core::f64::consts::PI * frequency,
                 phase: *phase,
@@ -81,8 +91,10 @@ impl Reference {
             SourceSpec::Polynomial { coefficients } => Kind::Polynomial(coefficients.clone()),
             SourceSpec::Csv { file, column, .. } => {
                 let path: PathBuf = base.join(file);
-                let table = Table::load(&path, column)
-                    .map_err(|source| ReferenceError::Table { joint: joint.into(), source })?;
+                let table = Table::load(&path, column).map_err(|source| ReferenceError::Table {
+                    joint: joint.into(),
+                    source,
+                })?;
                 if smooth {
                     Kind::Spline(table.into_spline())
                 } else {
@@ -91,12 +103,18 @@ impl Reference {
             }
             other => Kind::Piecewise(Piecewise::new(other, joint, initial, seed)),
         };
-        Ok(Self { kind, memo: (f64::NAN, 0.0) })
+        Ok(Self {
+            kind,
+            memo: (f64::NAN, 0.0),
+        })
     }
 
     /// A constant reference.
     pub fn constant(value: f64) -> Self {
-        Self { kind: Kind::Constant(value), memo: (f64::NAN, 0.0) }
+        Self {
+            kind: Kind::Constant(value),
+            memo: (f64::NAN, 0.0),
+        }
     }
 
     /// The value at `t_ns` nanoseconds (repeated queries at one time are answered from a memo).
@@ -106,9 +124,12 @@ impl Reference {
         }
         let v = match &mut self.kind {
             Kind::Constant(c) => *c,
-            Kind::Sine { amplitude, omega, phase, offset } => {
-                *offset + *amplitude * libm::sin(*omega * seconds(t_ns) + *phase)
-            }
+            Kind::Sine {
+                amplitude,
+                omega,
+                phase,
+                offset,
+            } => *offset + *amplitude * libm::sin(*omega * seconds(t_ns) + *phase),
             Kind::Polynomial(c) => horner(c, seconds(t_ns)),
             Kind::Piecewise(p) => p.value(t_ns),
             Kind::Linear(t) => t.linear(seconds(t_ns)),
@@ -135,7 +156,12 @@ impl Reference {
         let t = seconds(t_ns);
         match &mut self.kind {
             Kind::Constant(c) => [*c, 0.0, 0.0],
-            Kind::Sine { amplitude, omega, phase, offset } => {
+            Kind::Sine {
+                amplitude,
+                omega,
+                phase,
+                offset,
+            } => {
                 let (s, c) = libm::sincos(*omega * t + *phase);
                 let a = *amplitude;
                 [*offset + a * s, a * *omega * c, -a * *omega * *omega * s]
@@ -174,13 +200,21 @@ mod tests {
     #[test]
     fn polynomial_derivatives_are_exact() {
         // 1 + 2t + 3t² + 4t³ at t = 2: 49, 2 + 12 + 48 = 62, 6 + 48 = 54.
-        assert_eq!(polynomial_derivatives(&[1.0, 2.0, 3.0, 4.0], 2.0), [49.0, 62.0, 54.0]);
+        assert_eq!(
+            polynomial_derivatives(&[1.0, 2.0, 3.0, 4.0], 2.0),
+            [49.0, 62.0, 54.0]
+        );
         assert_eq!(horner(&[1.0, 2.0, 3.0, 4.0], 2.0), 49.0);
     }
 
     #[test]
     fn sine_derivatives_are_analytic() {
-        let spec = SourceSpec::Sine { amplitude: 0.5, frequency: 2.0, phase: 0.3, offset: 0.1 };
+        let spec = SourceSpec::Sine {
+            amplitude: 0.5,
+            frequency: 2.0,
+            phase: 0.3,
+            offset: 0.1,
+        };
         let mut r = Reference::build(&spec, "roll", 0.0, 1, Path::new("."), true).unwrap();
         let t = 0.123;
         let w = 4.0 * core::f64::consts::PI;

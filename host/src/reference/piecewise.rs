@@ -14,7 +14,11 @@ use margemu_model::time::nanos_from_seconds;
 enum Shape {
     Hold(f64),
     /// `offset + amplitude · sin(ω (t − start))`.
-    Sine { amplitude: f64, omega: f64, offset: f64 },
+    Sine {
+        amplitude: f64,
+        omega: f64,
+        offset: f64,
+    },
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -29,8 +33,18 @@ enum Generator {
     Done,
     /// Waypoints `[value, hold]` repeated from `next`.
     Cycle { points: Vec<[f64; 2]>, next: usize },
-    RandomSetpoints { rng: Box<StreamRng>, range: [f64; 2], hold: [f64; 2] },
-    RandomSine { rng: Box<StreamRng>, amplitude: [f64; 2], frequency: [f64; 2], segment: [f64; 2], offset: f64 },
+    RandomSetpoints {
+        rng: Box<StreamRng>,
+        range: [f64; 2],
+        hold: [f64; 2],
+    },
+    RandomSine {
+        rng: Box<StreamRng>,
+        amplitude: [f64; 2],
+        frequency: [f64; 2],
+        segment: [f64; 2],
+        offset: f64,
+    },
 }
 
 /// A piecewise reference with a forward-moving cursor.
@@ -51,7 +65,12 @@ fn ns(s: f64) -> u64 {
 impl Piecewise {
     pub(super) fn new(spec: &SourceSpec, joint: &str, initial: f64, seed: u64) -> Self {
         let rng = || Box::new(stream(seed, &format!("reference/{joint}")));
-        let mut p = Self { segments: Vec::new(), end_ns: 0, generator: Generator::Done, cursor: 0 };
+        let mut p = Self {
+            segments: Vec::new(),
+            end_ns: 0,
+            generator: Generator::Done,
+            cursor: 0,
+        };
         match spec {
             SourceSpec::Steps { points, .. } => {
                 p.push(0, Shape::Hold(initial));
@@ -65,7 +84,10 @@ impl Piecewise {
             }
             SourceSpec::Waypoints { points, repeat, .. } => {
                 if *repeat {
-                    p.generator = Generator::Cycle { points: points.clone(), next: 0 };
+                    p.generator = Generator::Cycle {
+                        points: points.clone(),
+                        next: 0,
+                    };
                 } else {
                     let mut start = 0;
                     for &[v, hold] in points {
@@ -75,9 +97,18 @@ impl Piecewise {
                 }
             }
             SourceSpec::RandomSetpoints { range, hold, .. } => {
-                p.generator = Generator::RandomSetpoints { rng: rng(), range: *range, hold: *hold };
+                p.generator = Generator::RandomSetpoints {
+                    rng: rng(),
+                    range: *range,
+                    hold: *hold,
+                };
             }
-            SourceSpec::RandomSine { amplitude, frequency, segment, offset } => {
+            SourceSpec::RandomSine {
+                amplitude,
+                frequency,
+                segment,
+                offset,
+            } => {
                 p.generator = Generator::RandomSine {
                     rng: rng(),
                     amplitude: *amplitude,
@@ -101,7 +132,11 @@ impl Piecewise {
 
     /// Appends the next segment; returns false when the generator is exhausted.
     fn generate(&mut self) -> bool {
-        let start = if self.segments.is_empty() { 0 } else { self.end_ns };
+        let start = if self.segments.is_empty() {
+            0
+        } else {
+            self.end_ns
+        };
         let (shape, length_ns) = match &mut self.generator {
             Generator::Done => return false,
             Generator::Cycle { points, next } => {
@@ -113,17 +148,30 @@ impl Piecewise {
                 let v = uniform(rng, range[0], range[1]);
                 (Shape::Hold(v), ns(uniform(rng, hold[0], hold[1])))
             }
-            Generator::RandomSine { rng, amplitude, frequency, segment, offset } => {
+            Generator::RandomSine {
+                rng,
+                amplitude,
+                frequency,
+                segment,
+                offset,
+            } => {
                 let a = uniform(rng, amplitude[0], amplitude[1]);
                 let f = uniform(rng, frequency[0], frequency[1]);
                 let length = uniform(rng, segment[0], segment[1]);
                 // Whole half periods: the segment starts and ends at its offset.
                 let half_periods = libm::round(length * 2.0 * f).max(1.0);
-                let shape = Shape::Sine { amplitude: a, omega: 2.0 * core::f64::consts::PI * f, offset: *offset };
+                let shape = Shape::Sine {
+                    amplitude: a,
+                    omega: 2.0 * core::f64::consts::PI * f,
+                    offset: *offset,
+                };
                 (shape, ns(half_periods / (2.0 * f)))
             }
         };
-        self.segments.push(Segment { start_ns: start, shape });
+        self.segments.push(Segment {
+            start_ns: start,
+            shape,
+        });
         self.end_ns = start.saturating_add(length_ns.max(1));
         true
     }
@@ -180,10 +228,18 @@ impl Piecewise {
     fn evaluate(seg: Segment, t_ns: f64) -> Derivatives {
         match seg.shape {
             Shape::Hold(v) => [v, 0.0, 0.0],
-            Shape::Sine { amplitude, omega, offset } => {
+            Shape::Sine {
+                amplitude,
+                omega,
+                offset,
+            } => {
                 let t = (t_ns - seg.start_ns as f64) * 1e-9;
                 let (s, c) = libm::sincos(omega * t);
-                [offset + amplitude * s, amplitude * omega * c, -amplitude * omega * omega * s]
+                [
+                    offset + amplitude * s,
+                    amplitude * omega * c,
+                    -amplitude * omega * omega * s,
+                ]
             }
         }
     }
@@ -195,7 +251,10 @@ mod tests {
 
     #[test]
     fn steps_switch_at_their_exact_instant() {
-        let spec = SourceSpec::Steps { points: vec![[0.3, 1.0], [0.7, -2.0]], smoothing: None };
+        let spec = SourceSpec::Steps {
+            points: vec![[0.3, 1.0], [0.7, -2.0]],
+            smoothing: None,
+        };
         let mut p = Piecewise::new(&spec, "x", 0.5, 1);
         assert_eq!(p.value(0.0), 0.5);
         assert_eq!(p.value(299_999_999.5), 0.5);
@@ -211,7 +270,11 @@ mod tests {
 
     #[test]
     fn waypoints_hold_and_repeat() {
-        let spec = SourceSpec::Waypoints { points: vec![[1.0, 0.5], [2.0, 0.25]], repeat: true, smoothing: None };
+        let spec = SourceSpec::Waypoints {
+            points: vec![[1.0, 0.5], [2.0, 0.25]],
+            repeat: true,
+            smoothing: None,
+        };
         let mut p = Piecewise::new(&spec, "y", 0.0, 1);
         let at = |p: &mut Piecewise, s: f64| p.value(s * 1e9);
         assert_eq!(at(&mut p, 0.0), 1.0);
@@ -222,7 +285,11 @@ mod tests {
 
     #[test]
     fn random_setpoints_stay_in_range_and_repeat_with_the_seed() {
-        let spec = SourceSpec::RandomSetpoints { range: [-0.2, 0.3], hold: [0.5, 1.5], smoothing: None };
+        let spec = SourceSpec::RandomSetpoints {
+            range: [-0.2, 0.3],
+            hold: [0.5, 1.5],
+            smoothing: None,
+        };
         let mut a = Piecewise::new(&spec, "x", 0.0, 9);
         let mut b = Piecewise::new(&spec, "x", 0.0, 9);
         let mut c = Piecewise::new(&spec, "y", 0.0, 9);
@@ -235,13 +302,27 @@ mod tests {
             differs |= v != c.value(t);
         }
         assert!(differs, "streams of different joints must differ");
-        let holds: Vec<u64> = a.segments.windows(2).map(|w| w[1].start_ns - w[0].start_ns).collect();
-        assert!(holds.iter().all(|&h| (500_000_000..=1_500_000_000).contains(&h)), "{holds:?}");
+        let holds: Vec<u64> = a
+            .segments
+            .windows(2)
+            .map(|w| w[1].start_ns - w[0].start_ns)
+            .collect();
+        assert!(
+            holds
+                .iter()
+                .all(|&h| (500_000_000..=1_500_000_000).contains(&h)),
+            "{holds:?}"
+        );
     }
 
     #[test]
     fn random_sine_segments_are_continuous() {
-        let spec = SourceSpec::RandomSine { amplitude: [0.1, 1.0], frequency: [0.5, 5.0], segment: [0.5, 2.0], offset: 0.2 };
+        let spec = SourceSpec::RandomSine {
+            amplitude: [0.1, 1.0],
+            frequency: [0.5, 5.0],
+            segment: [0.5, 2.0],
+            offset: 0.2,
+        };
         let mut p = Piecewise::new(&spec, "roll", 0.0, 3);
         let mut last = p.value(0.0);
         for k in 1..200_000 {

@@ -54,25 +54,40 @@ pub struct Table {
 impl Table {
     /// Loads column `column` against column `t` from `path`.
     pub fn load(path: &Path, column: &str) -> Result<Self, TableError> {
-        let read = |source| TableError::Read { path: path.to_path_buf(), source };
-        let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).map_err(read)?;
+        let read = |source| TableError::Read {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_path(path)
+            .map_err(read)?;
         let header = reader.headers().map_err(read)?.clone();
         let find = |name: &str| {
-            header.iter().position(|h| h == name).ok_or_else(|| TableError::MissingColumn {
-                path: path.to_path_buf(),
-                column: name.to_owned(),
-                found: header.iter().collect::<Vec<_>>().join(", "),
-            })
+            header
+                .iter()
+                .position(|h| h == name)
+                .ok_or_else(|| TableError::MissingColumn {
+                    path: path.to_path_buf(),
+                    column: name.to_owned(),
+                    found: header.iter().collect::<Vec<_>>().join(", "),
+                })
         };
         let (ti, yi) = (find("t")?, find(column)?);
         let (mut t, mut y) = (Vec::new(), Vec::new());
         for record in reader.records() {
             let record = record.map_err(read)?;
             let line = record.position().map_or(0, |p| p.line());
-            let bad = |reason: String| TableError::BadRow { path: path.to_path_buf(), line, reason };
+            let bad = |reason: String| TableError::BadRow {
+                path: path.to_path_buf(),
+                line,
+                reason,
+            };
             let field = |i: usize, name: &str| -> Result<f64, TableError> {
                 let text = record.get(i).unwrap_or("");
-                let v: f64 = text.parse().map_err(|_| bad(format!("`{name}` = {text:?} is not a number")))?;
+                let v: f64 = text
+                    .parse()
+                    .map_err(|_| bad(format!("`{name}` = {text:?} is not a number")))?;
                 if v.is_finite() {
                     Ok(v)
                 } else {
@@ -87,14 +102,24 @@ impl Table {
             y.push(yv);
         }
         if t.is_empty() {
-            return Err(TableError::Empty { path: path.to_path_buf() });
+            return Err(TableError::Empty {
+                path: path.to_path_buf(),
+            });
         }
-        Ok(Self { t, y, m: Vec::new() })
+        Ok(Self {
+            t,
+            y,
+            m: Vec::new(),
+        })
     }
 
     /// A table from samples (times strictly increasing, at least one).
     pub fn from_samples(t: Vec<f64>, y: Vec<f64>) -> Self {
-        Self { t, y, m: Vec::new() }
+        Self {
+            t,
+            y,
+            m: Vec::new(),
+        }
     }
 
     /// Index `i` with `t[i] ≤ x < t[i+1]`, or `None` outside the table.
@@ -126,7 +151,9 @@ impl Table {
 
     /// Slope of the linear interpolation (0 outside the table).
     pub fn slope(&self, x: f64) -> f64 {
-        self.interval(x).map_or(0.0, |i| (self.y[i + 1] - self.y[i]) / (self.t[i + 1] - self.t[i]))
+        self.interval(x).map_or(0.0, |i| {
+            (self.y[i + 1] - self.y[i]) / (self.t[i + 1] - self.t[i])
+        })
     }
 
     /// Computes the natural cubic spline through the rows.
@@ -138,7 +165,8 @@ impl Table {
             let (mut c, mut d) = (vec![0.0; n], vec![0.0; n]);
             for i in 1..n - 1 {
                 let (h0, h1) = (self.t[i] - self.t[i - 1], self.t[i + 1] - self.t[i]);
-                let rhs = 6.0 * ((self.y[i + 1] - self.y[i]) / h1 - (self.y[i] - self.y[i - 1]) / h0);
+                let rhs =
+                    6.0 * ((self.y[i + 1] - self.y[i]) / h1 - (self.y[i] - self.y[i - 1]) / h0);
                 let diag = 2.0 * (h0 + h1) - h0 * c[i - 1];
                 c[i] = h1 / diag;
                 d[i] = (rhs - h0 * d[i - 1]) / diag;
@@ -153,7 +181,9 @@ impl Table {
 
     /// Spline value, slope and curvature (constant value outside the table).
     pub fn spline(&self, x: f64) -> Derivatives {
-        let Some(i) = self.interval(x) else { return [self.clamp_value(x), 0.0, 0.0] };
+        let Some(i) = self.interval(x) else {
+            return [self.clamp_value(x), 0.0, 0.0];
+        };
         let h = self.t[i + 1] - self.t[i];
         let (a, b) = ((self.t[i + 1] - x) / h, (x - self.t[i]) / h);
         let (m0, m1, y0, y1) = (self.m[i], self.m[i + 1], self.y[i], self.y[i + 1]);
@@ -198,8 +228,14 @@ mod tests {
         let err = Table::load(&path, "z").unwrap_err().to_string();
         assert!(err.ends_with(":3: `z` = \"oops\" is not a number"), "{err}");
         std::fs::write(&path, "t,z\n0,1\n0,2\n").unwrap();
-        assert!(Table::load(&path, "z").unwrap_err().to_string().contains(":3: t = 0 does not increase"));
+        assert!(Table::load(&path, "z")
+            .unwrap_err()
+            .to_string()
+            .contains(":3: t = 0 does not increase"));
         let err = Table::load(&path, "q").unwrap_err().to_string();
-        assert!(err.contains("no column `q` in the header (columns: t, z)"), "{err}");
+        assert!(
+            err.contains("no column `q` in the header (columns: t, z)"),
+            "{err}"
+        );
     }
 }

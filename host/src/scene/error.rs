@@ -42,7 +42,10 @@ pub(crate) enum PathPart {
 impl Violation {
     pub fn at(path: &[&str], reason: impl Into<String>) -> Self {
         Self {
-            path: path.iter().map(|k| PathPart::Key((*k).to_owned())).collect(),
+            path: path
+                .iter()
+                .map(|k| PathPart::Key((*k).to_owned()))
+                .collect(),
             reason: reason.into(),
         }
     }
@@ -70,12 +73,20 @@ impl Violation {
 
 impl SceneError {
     pub(crate) fn io(path: &Path, e: &std::io::Error) -> Self {
-        Self { file: path.to_path_buf(), position: None, reason: format!("cannot read: {e}") }
+        Self {
+            file: path.to_path_buf(),
+            position: None,
+            reason: format!("cannot read: {e}"),
+        }
     }
 
     pub(crate) fn from_toml(path: &Path, text: &str, e: &toml::de::Error) -> Self {
         let position = e.span().map(|s| line_col(text, s.start));
-        Self { file: path.to_path_buf(), position, reason: e.message().trim().to_owned() }
+        Self {
+            file: path.to_path_buf(),
+            position,
+            reason: e.message().trim().to_owned(),
+        }
     }
 
     pub(crate) fn from_violation(path: &Path, text: &str, v: Violation) -> Self {
@@ -85,7 +96,11 @@ impl SceneError {
         } else {
             format!("`{}`: {}", v.dotted(), v.reason)
         };
-        Self { file: path.to_path_buf(), position: span.map(|s| line_col(text, s)), reason }
+        Self {
+            file: path.to_path_buf(),
+            position: span.map(|s| line_col(text, s)),
+            reason,
+        }
     }
 }
 
@@ -133,10 +148,19 @@ mod tests {
     fn values_are_located_by_key_path() {
         let text = "x = 1\n[bench]\nplate_mass = -2.0\ninitial = [0, 1, 2]\n";
         let v = Violation::at(&["bench", "plate_mass"], "must be positive");
-        assert_eq!(locate(text, &v.path).map(|at| line_col(text, at)), Some((3, 14)));
+        assert_eq!(
+            locate(text, &v.path).map(|at| line_col(text, at)),
+            Some((3, 14))
+        );
         let v = Violation::at(&["bench", "initial"], "bad").index(2);
-        assert_eq!(locate(text, &v.path).map(|at| line_col(text, at)), Some((4, 18)));
+        assert_eq!(
+            locate(text, &v.path).map(|at| line_col(text, at)),
+            Some((4, 18))
+        );
         let missing = Violation::at(&["bench", "nothing"], "absent");
-        assert_eq!(locate(text, &missing.path).map(|at| line_col(text, at)), Some((2, 1)));
+        assert_eq!(
+            locate(text, &missing.path).map(|at| line_col(text, at)),
+            Some((2, 1))
+        );
     }
 }

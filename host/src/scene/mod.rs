@@ -55,8 +55,8 @@ impl Scene {
     pub fn parse_str(text: &str, path: &Path) -> Result<Self, SceneError> {
         let spec: SceneSpec =
             toml::from_str(text).map_err(|e| SceneError::from_toml(path, text, &e))?;
-        let checked = validate::check(&spec, path)
-            .map_err(|v| SceneError::from_violation(path, text, v))?;
+        let checked =
+            validate::check(&spec, path).map_err(|v| SceneError::from_violation(path, text, v))?;
         Ok(Self {
             spec,
             path: path.to_path_buf(),

@@ -82,7 +82,10 @@ pub struct IntegratorSpec {
 
 impl Default for IntegratorSpec {
     fn default() -> Self {
-        Self { method: Method::Rk4, step: 0.001 }
+        Self {
+            method: Method::Rk4,
+            step: 0.001,
+        }
     }
 }
 
@@ -120,7 +123,10 @@ pub struct FieldSpec {
 
 impl Default for FieldSpec {
     fn default() -> Self {
-        Self { reference: [0.5, 0.0, -0.83], unit: FieldUnit::Normalized }
+        Self {
+            reference: [0.5, 0.0, -0.83],
+            unit: FieldUnit::Normalized,
+        }
     }
 }
 

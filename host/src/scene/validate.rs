@@ -31,7 +31,10 @@ pub(crate) fn check(spec: &SceneSpec, _path: &Path) -> Result<Checked, Violation
         ));
     }
     if clock.count_before(duration_ns) == 0 {
-        return Err(Violation::at(&["duration"], "shorter than one output sample"));
+        return Err(Violation::at(
+            &["duration"],
+            "shorter than one output sample",
+        ));
     }
     all_finite(&spec.field.reference, &["field", "reference"])?;
     check_bench(&spec.bench)?;
@@ -39,7 +42,11 @@ pub(crate) fn check(spec: &SceneSpec, _path: &Path) -> Result<Checked, Violation
     for (name, source) in &spec.joints {
         check_joint(name, source, spec.motion)?;
     }
-    Ok(Checked { clock, duration_ns, step_ns })
+    Ok(Checked {
+        clock,
+        duration_ns,
+        step_ns,
+    })
 }
 
 fn check_bench(b: &BenchSpec) -> Check {
@@ -53,7 +60,10 @@ fn check_bench(b: &BenchSpec) -> Check {
     }
     all_finite(&b.initial, &["bench", "initial"])?;
     if !(b.gravity.is_finite() && b.gravity >= 0.0) {
-        return Err(Violation::at(&["bench", "gravity"], "must be finite and ≥ 0"));
+        return Err(Violation::at(
+            &["bench", "gravity"],
+            "must be finite and ≥ 0",
+        ));
     }
     Ok(())
 }
@@ -64,19 +74,32 @@ fn check_control(c: &ControlSpec) -> Check {
             return Err(Violation::at(&["control", "overshoot"], "must be in (0, 1)").index(i));
         }
     }
-    all_positive(&c.settling_time, &["control", "settling_time"], "a settling time")?;
+    all_positive(
+        &c.settling_time,
+        &["control", "settling_time"],
+        "a settling time",
+    )?;
     if !(c.pole_ratio.is_finite() && c.pole_ratio >= 1.0) {
-        return Err(Violation::at(&["control", "pole_ratio"], "must be finite and ≥ 1"));
+        return Err(Violation::at(
+            &["control", "pole_ratio"],
+            "must be finite and ≥ 1",
+        ));
     }
     if !(c.retune_margin.is_finite() && c.retune_margin > 0.0 && c.retune_margin <= 1.0) {
-        return Err(Violation::at(&["control", "retune_margin"], "must be in (0, 1]"));
+        return Err(Violation::at(
+            &["control", "retune_margin"],
+            "must be in (0, 1]",
+        ));
     }
     if let Some(gains) = &c.gains {
         for (i, g) in gains.iter().enumerate() {
             all_finite(g, &["control", "gains"]).map_err(|v| v.index(i))?;
         }
     }
-    finite_positive(c.external_acceleration, &["control", "external_acceleration"])?;
+    finite_positive(
+        c.external_acceleration,
+        &["control", "external_acceleration"],
+    )?;
     finite_positive(c.oscillation_rate, &["control", "oscillation_rate"])?;
     Ok(())
 }
@@ -100,7 +123,11 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
                     "`{}`{} cannot prescribe motion directly (kinematic mode needs twice \
                      differentiable sources: constant, sine, polynomial, random-sine, csv)",
                     source.type_name(),
-                    if source.smoothing().is_some() { " with smoothing" } else { "" }
+                    if source.smoothing().is_some() {
+                        " with smoothing"
+                    } else {
+                        ""
+                    }
                 ),
             ));
         }
@@ -108,7 +135,10 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
     }
     if let Some(s) = source.smoothing() {
         let at = ["joints", name, "smoothing"];
-        finite_positive(s.natural_frequency, &[at[0], at[1], at[2], "natural_frequency"])?;
+        finite_positive(
+            s.natural_frequency,
+            &[at[0], at[1], at[2], "natural_frequency"],
+        )?;
         finite_positive(s.damping, &[at[0], at[1], at[2], "damping"])?;
     }
     let key = |k: &'static str| [at[0], at[1], k];
@@ -142,7 +172,12 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
             }
             Ok(())
         }
-        SourceSpec::Sine { amplitude, frequency, phase, offset } => {
+        SourceSpec::Sine {
+            amplitude,
+            frequency,
+            phase,
+            offset,
+        } => {
             finite(*amplitude, &key("amplitude"))?;
             non_negative(*frequency, &key("frequency"))?;
             finite(*phase, &key("phase"))?;
@@ -156,7 +191,12 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
             interval(range, &key("range"), false)?;
             interval(hold, &key("hold"), true)
         }
-        SourceSpec::RandomSine { amplitude, frequency, segment, offset } => {
+        SourceSpec::RandomSine {
+            amplitude,
+            frequency,
+            segment,
+            offset,
+        } => {
             interval(amplitude, &key("amplitude"), false)?;
             interval(frequency, &key("frequency"), true)?;
             interval(segment, &key("segment"), true)?;
@@ -175,7 +215,10 @@ fn positive_nanos(s: f64, at: &[&str]) -> Result<Nanos, Violation> {
     finite_positive(s, at)?;
     match nanos_from_seconds(s) {
         Some(ns) if ns > 0 => Ok(ns),
-        _ => Err(Violation::at(at, "must be at least 1 ns and at most 584 years")),
+        _ => Err(Violation::at(
+            at,
+            "must be at least 1 ns and at most 584 years",
+        )),
     }
 }
 
@@ -191,7 +234,10 @@ fn finite_positive(x: f64, at: &[&str]) -> Check {
     if x.is_finite() && x > 0.0 {
         Ok(())
     } else {
-        Err(Violation::at(at, format!("must be finite and > 0, not {x}")))
+        Err(Violation::at(
+            at,
+            format!("must be finite and > 0, not {x}"),
+        ))
     }
 }
 
@@ -199,7 +245,10 @@ fn non_negative(x: f64, at: &[&str]) -> Check {
     if x.is_finite() && x >= 0.0 {
         Ok(())
     } else {
-        Err(Violation::at(at, format!("must be finite and ≥ 0, not {x}")))
+        Err(Violation::at(
+            at,
+            format!("must be finite and ≥ 0, not {x}"),
+        ))
     }
 }
 
@@ -213,7 +262,9 @@ fn all_finite(xs: &[f64], at: &[&str]) -> Check {
 fn all_positive(xs: &[f64], at: &[&str], what: &str) -> Check {
     for (i, &x) in xs.iter().enumerate() {
         if !(x.is_finite() && x > 0.0) {
-            return Err(Violation::at(at, format!("{what} must be finite and > 0, not {x}")).index(i));
+            return Err(
+                Violation::at(at, format!("{what} must be finite and > 0, not {x}")).index(i),
+            );
         }
     }
     Ok(())
@@ -238,7 +289,10 @@ fn non_empty<T>(xs: &[T], at: &[&str]) -> Check {
 fn interval(r: &[f64; 2], at: &[&str], positive: bool) -> Check {
     all_finite(r, at)?;
     if r[0] > r[1] {
-        return Err(Violation::at(at, format!("[lo, hi] must have lo ≤ hi, not {r:?}")));
+        return Err(Violation::at(
+            at,
+            format!("[lo, hi] must have lo ≤ hi, not {r:?}"),
+        ));
     }
     if positive && r[0] <= 0.0 {
         return Err(Violation::at(at, "must be > 0").index(0));
