@@ -6,6 +6,7 @@
 //!   truth (no file output).
 //! - [`mode_costs`]: the cost per output sample of a static, a kinematic and a bench scene.
 
+use crate::reference::ReferenceError;
 use crate::run::run;
 use crate::scene::{Method, Scene};
 use crate::truth::{geodesic_angle, Truth};
@@ -50,40 +51,38 @@ pub fn with_integrator(scene: &Scene, method: Method, step: f64) -> Scene {
     s
 }
 
-fn trajectory(scene: &Scene) -> Vec<([f64; 4], [f64; 3])> {
+fn trajectory(scene: &Scene) -> Result<Vec<([f64; 4], [f64; 3])>, ReferenceError> {
     let mut out = Vec::with_capacity(scene.samples() as usize);
-    let sink = |t: &Truth| -> Result<(), ()> {
-        out.push((t.quaternion, t.position));
+    run_once(scene, |t| out.push((t.quaternion, t.position)))?;
+    Ok(out)
+}
+
+/// Runs `scene` once, handing each truth sample to `each`.
+fn run_once(scene: &Scene, mut each: impl FnMut(&Truth)) -> Result<(), ReferenceError> {
+    let sink = |t: &Truth| -> Result<(), std::convert::Infallible> {
+        each(t);
         Ok(())
     };
-    run(scene, sink, |_, _| {})
-        .expect("scene builds")
-        .expect("sink never fails");
-    out
+    match run(scene, sink, |_, _| {})? {
+        Ok(_) => Ok(()),
+        Err(never) => match never {},
+    }
 }
 
 /// Times full runs of `scene` (truth computed, nothing written) for at least `min_wall`;
 /// returns wall seconds per run. One untimed run first warms caches and the per-process PID
 /// synthesis memo, so the figure is the steady per-sample cost.
-pub fn time_run(scene: &Scene, min_wall: Duration) -> f64 {
-    run(scene, |_| Ok::<(), ()>(()), |_, _| {})
-        .expect("scene builds")
-        .expect("sink never fails");
+pub fn time_run(scene: &Scene, min_wall: Duration) -> Result<f64, ReferenceError> {
+    run_once(scene, |_| {})?;
     let mut runs = 0u32;
     let start = Instant::now();
     while runs == 0 || start.elapsed() < min_wall {
         let mut acc = 0.0;
-        let sink = |t: &Truth| -> Result<(), ()> {
-            acc += t.quaternion[0] + t.specific_force[2];
-            Ok(())
-        };
-        run(scene, sink, |_, _| {})
-            .expect("scene builds")
-            .expect("sink never fails");
+        run_once(scene, |t| acc += t.quaternion[0] + t.specific_force[2])?;
         black_box(acc);
         runs += 1;
     }
-    start.elapsed().as_secs_f64() / runs as f64
+    Ok(start.elapsed().as_secs_f64() / runs as f64)
 }
 
 /// Errors and speed of each `(method, step)` on `scene`, against RK4 at `reference_step`.
@@ -92,38 +91,38 @@ pub fn integrator_sweep(
     configs: &[(Method, f64)],
     reference_step: f64,
     min_wall: Duration,
-) -> Vec<IntegratorRow> {
-    let reference = trajectory(&with_integrator(scene, Method::Rk4, reference_step));
+) -> Result<Vec<IntegratorRow>, ReferenceError> {
+    let reference = trajectory(&with_integrator(scene, Method::Rk4, reference_step))?;
     configs
         .iter()
         .map(|&(method, step)| {
             let s = with_integrator(scene, method, step);
-            let traj = trajectory(&s);
+            let traj = trajectory(&s)?;
             let (mut att, mut pos) = (0.0f64, 0.0f64);
             for ((q, p), (qr, pr)) in traj.iter().zip(&reference) {
                 att = att.max(geodesic_angle(q, qr));
                 let d = [p[0] - pr[0], p[1] - pr[1], p[2] - pr[2]];
                 pos = pos.max((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt());
             }
-            let wall = time_run(&s, min_wall);
-            IntegratorRow {
+            let wall = time_run(&s, min_wall)?;
+            Ok(IntegratorRow {
                 method,
                 step,
                 max_attitude_error: att,
                 max_position_error: pos,
                 realtime_factor: s.spec.duration / wall,
-            }
+            })
         })
         .collect()
 }
 
 /// Cost per output sample of each scene.
-pub fn mode_costs(scenes: &[Scene], min_wall: Duration) -> Vec<ModeRow> {
+pub fn mode_costs(scenes: &[Scene], min_wall: Duration) -> Result<Vec<ModeRow>, ReferenceError> {
     scenes
         .iter()
         .map(|s| {
-            let wall = time_run(s, min_wall);
-            ModeRow {
+            let wall = time_run(s, min_wall)?;
+            Ok(ModeRow {
                 name: s
                     .spec
                     .name
@@ -132,7 +131,7 @@ pub fn mode_costs(scenes: &[Scene], min_wall: Duration) -> Vec<ModeRow> {
                 mode: format!("{:?}", s.spec.motion).to_lowercase(),
                 ns_per_sample: wall * 1e9 / s.samples() as f64,
                 realtime_factor: s.spec.duration / wall,
-            }
+            })
         })
         .collect()
 }

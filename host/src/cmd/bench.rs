@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 use margemu::perf::{integrator_sweep, mode_costs};
-use margemu::scene::{Method, Scene};
+use margemu::scene::{Method, MotionMode, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -46,6 +46,13 @@ impl Cmd {
                     Some(p) => Scene::load(&p)?,
                     None => builtin(FIGURE3, "figure3.toml (built in)")?,
                 };
+                if scene.spec.motion != MotionMode::Bench {
+                    anyhow::bail!(
+                        "{}: `bench integrators` needs a bench scene (motion = \"bench\"); {:?} scenes integrate nothing",
+                        scene.path.display(),
+                        scene.spec.motion
+                    );
+                }
                 let configs = [
                     (Method::Rk4, 0.001),
                     (Method::Rk4, 0.0005),
@@ -72,7 +79,7 @@ impl Cmd {
                     &configs,
                     reference_step,
                     Duration::from_secs_f64(seconds),
-                );
+                )?;
                 for r in rows {
                     println!(
                         "| {:?} | {} | {:.3e} | {:.3e} | {:.0} |",
@@ -98,7 +105,7 @@ impl Cmd {
                     "| scene | mode | output rate (Hz) | ns per sample | simulated s / wall s |"
                 );
                 println!("|---|---|---|---|---|");
-                let rows = mode_costs(&scenes, Duration::from_secs_f64(seconds));
+                let rows = mode_costs(&scenes, Duration::from_secs_f64(seconds))?;
                 for (r, s) in rows.iter().zip(&scenes) {
                     println!(
                         "| {} | {} | {} | {:.1} | {:.0} |",
