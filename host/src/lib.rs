@@ -8,9 +8,11 @@
 //! - [`motion`]: static, kinematic or bench motion, so a scene pays only for what it uses;
 //! - [`truth`]: ground truth of the plate (attitude, rates, specific force, field) per sample;
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
-//! - [`perf`]: speed-against-error benchmarks behind `margemu bench`.
+//! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
+//! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`.
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod bench;
 pub mod motion;
 pub mod output;

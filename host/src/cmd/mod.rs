@@ -1,5 +1,6 @@
 //! Subcommands of `margemu`, one file each.
 
+pub mod analyze;
 pub mod bench;
 pub mod scene;
 pub mod simulate;
@@ -12,6 +13,9 @@ pub enum Command {
     Scene(scene::Cmd),
     /// Simulate a scene and write its run directory (truth.csv, meta.toml).
     Simulate(simulate::Cmd),
+    /// Analyse recorded columns (noise: Allan deviation and PSD).
+    #[command(subcommand)]
+    Analyze(analyze::Cmd),
     /// Measure speed against error on this machine.
     #[command(subcommand)]
     Bench(bench::Cmd),
@@ -23,6 +27,7 @@ impl Command {
             Command::Scene(c) => c.run(),
             Command::Simulate(c) => c.run(),
             Command::Bench(c) => c.run(),
+            Command::Analyze(c) => c.run(),
         }
     }
 }
