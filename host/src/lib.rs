@@ -3,8 +3,8 @@
 //!
 //! Layers, bottom up:
 //! - [`scene`]: the TOML scene file, validated with errors that point at file, line and column;
-//! - [`reference`]: each joint's reference signal (steps, waypoints, sines, random, CSV);
-//! - [`bench`]: the closed-loop bench (eq. 5–17): joints, friction, PID synthesis, integrators;
+//! - [`reference`](mod@reference): each joint's reference signal (steps, waypoints, sines, random, CSV);
+//! - [`bench`](mod@bench): the closed-loop bench (eq. 5–17): joints, friction, PID synthesis, integrators;
 //! - [`motion`]: static, kinematic or bench motion, so a scene pays only for what it uses;
 //! - [`truth`]: ground truth of the plate (attitude, rates, specific force, field) per sample;
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
