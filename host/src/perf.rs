@@ -7,9 +7,9 @@
 //! - [`mode_costs`]: the cost per output sample of a static, a kinematic and a bench scene.
 
 use crate::reference::ReferenceError;
-use crate::run::run;
+use crate::run::for_each;
 use crate::scene::{Method, Scene};
-use crate::truth::{geodesic_angle, Truth};
+use crate::truth::geodesic_angle;
 use margemu_model::time::nanos_from_seconds;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -51,34 +51,25 @@ pub fn with_integrator(scene: &Scene, method: Method, step: f64) -> Scene {
     s
 }
 
-fn trajectory(scene: &Scene) -> Result<Vec<([f64; 4], [f64; 3])>, ReferenceError> {
-    let mut out = Vec::with_capacity(scene.samples() as usize);
-    run_once(scene, |t| out.push((t.quaternion, t.position)))?;
-    Ok(out)
-}
+/// Attitude quaternion and position at every output sample.
+type Trajectory = Vec<([f64; 4], [f64; 3])>;
 
-/// Runs `scene` once, handing each truth sample to `each`.
-fn run_once(scene: &Scene, mut each: impl FnMut(&Truth)) -> Result<(), ReferenceError> {
-    let sink = |t: &Truth| -> Result<(), std::convert::Infallible> {
-        each(t);
-        Ok(())
-    };
-    match run(scene, sink, |_, _| {})? {
-        Ok(_) => Ok(()),
-        Err(never) => match never {},
-    }
+fn trajectory(scene: &Scene) -> Result<Trajectory, ReferenceError> {
+    let mut out = Vec::with_capacity(scene.samples() as usize);
+    for_each(scene, |t| out.push((t.quaternion, t.position)))?;
+    Ok(out)
 }
 
 /// Times full runs of `scene` (truth computed, nothing written) for at least `min_wall`;
 /// returns wall seconds per run. One untimed run first warms caches and the per-process PID
 /// synthesis memo, so the figure is the steady per-sample cost.
 pub fn time_run(scene: &Scene, min_wall: Duration) -> Result<f64, ReferenceError> {
-    run_once(scene, |_| {})?;
+    for_each(scene, |_| {})?;
     let mut runs = 0u32;
     let start = Instant::now();
     while runs == 0 || start.elapsed() < min_wall {
         let mut acc = 0.0;
-        run_once(scene, |t| acc += t.quaternion[0] + t.specific_force[2])?;
+        for_each(scene, |t| acc += t.quaternion[0] + t.specific_force[2])?;
         black_box(acc);
         runs += 1;
     }

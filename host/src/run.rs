@@ -75,6 +75,25 @@ pub fn run<E>(
     }))
 }
 
+/// Runs `scene`, handing the truth of every output sample to `each`, in time order.
+pub fn for_each(scene: &Scene, mut each: impl FnMut(&Truth)) -> Result<RunSummary, ReferenceError> {
+    let sink = |t: &Truth| -> Result<(), std::convert::Infallible> {
+        each(t);
+        Ok(())
+    };
+    match run(scene, sink, |_, _| {})? {
+        Ok(summary) => Ok(summary),
+        Err(never) => match never {},
+    }
+}
+
+/// The truth of every output sample of `scene`.
+pub fn collect(scene: &Scene) -> Result<Vec<Truth>, ReferenceError> {
+    let mut out = Vec::with_capacity(scene.samples() as usize);
+    for_each(scene, |t| out.push(*t))?;
+    Ok(out)
+}
+
 /// Runs `scene` and writes `dir/meta.toml` and `dir/truth.csv` (creating `dir`).
 pub fn simulate_to_dir(
     scene: &Scene,

@@ -1,7 +1,7 @@
 //! Ground truth against closed forms: constant-rate rotations, a level static plate, a
 //! sinusoidal translation, and the body rate against the finite difference of the attitude.
 
-use margemu::run::run;
+use margemu::run::collect;
 use margemu::scene::Scene;
 use margemu::truth::Truth;
 use std::f64::consts::PI;
@@ -10,20 +10,17 @@ use std::path::Path;
 const G: f64 = 9.80665;
 
 fn truths(text: &str) -> Vec<Truth> {
-    let scene = Scene::parse_str(text, Path::new("analytic.toml")).unwrap();
-    let mut out = Vec::new();
-    run(
-        &scene,
-        |t: &Truth| -> Result<(), ()> { Ok(out.push(*t)) },
-        |_, _| {},
-    )
-    .unwrap()
-    .unwrap();
-    out
+    collect(&Scene::parse_str(text, Path::new("analytic.toml")).unwrap()).unwrap()
 }
 
 fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol
+}
+
+fn assert_all_close(got: &[f64], want: &[f64], tol: f64, what: &str) {
+    for (i, (g, w)) in got.iter().zip(want).enumerate() {
+        assert!(close(*g, *w, tol), "{what}, component {i}: {g} vs {w}");
+    }
 }
 
 #[test]
@@ -39,14 +36,12 @@ fn constant_rate_rotation_about_each_axis_matches_the_closed_form() {
             let (s, c) = (0.5 * angle).sin_cos();
             let mut expected_q = [c, 0.0, 0.0, 0.0];
             expected_q[axis + 1] = s;
-            for i in 0..4 {
-                assert!(
-                    close(t.quaternion[i], expected_q[i], 1e-12),
-                    "{joint} q at {}: {:?}",
-                    t.t_ns,
-                    t.quaternion
-                );
-            }
+            assert_all_close(
+                &t.quaternion,
+                &expected_q,
+                1e-12,
+                &format!("{joint} q at {}", t.t_ns),
+            );
             let mut rate = [0.0; 3];
             rate[axis] = w;
             assert_eq!(t.body_rate, rate, "{joint} body rate");
@@ -58,14 +53,12 @@ fn constant_rate_rotation_about_each_axis_matches_the_closed_form() {
                 1 => [-G * sa, 0.0, G * ca],
                 _ => [0.0, 0.0, G],
             };
-            for i in 0..3 {
-                assert!(
-                    close(t.specific_force[i], f[i], 1e-12),
-                    "{joint} f at {}: {:?}",
-                    t.t_ns,
-                    t.specific_force
-                );
-            }
+            assert_all_close(
+                &t.specific_force,
+                &f,
+                1e-12,
+                &format!("{joint} f at {}", t.t_ns),
+            );
         }
     }
 }
@@ -116,30 +109,30 @@ fn check_finite_differences(ts: &[Truth], rate_tol: f64, accel_tol: f64) {
         let (a, b) = (&pair[0], &pair[1]);
         let dt = (b.t_ns - a.t_ns) as f64 * 1e-9;
         let fd = rate_from_attitudes(&a.quaternion, &b.quaternion, dt);
-        for i in 0..3 {
-            let mid = 0.5 * (a.body_rate[i] + b.body_rate[i]);
-            assert!(
-                close(fd[i], mid, rate_tol),
-                "rate {i} at {}: fd {} vs {}",
-                a.t_ns,
-                fd[i],
-                mid
-            );
-            let fd_accel = (b.body_rate[i] - a.body_rate[i]) / dt;
-            let mid_accel = 0.5 * (a.angular_accel[i] + b.angular_accel[i]);
-            assert!(
-                close(fd_accel, mid_accel, accel_tol),
-                "ang. accel {i} at {}: {fd_accel} vs {mid_accel}",
-                a.t_ns
-            );
-            let fd_lin = (b.velocity[i] - a.velocity[i]) / dt;
-            let mid_lin = 0.5 * (a.accel_world[i] + b.accel_world[i]);
-            assert!(
-                close(fd_lin, mid_lin, accel_tol),
-                "accel {i} at {}: {fd_lin} vs {mid_lin}",
-                a.t_ns
-            );
-        }
+        let mean = |x: &[f64; 3], y: &[f64; 3]| [0, 1, 2].map(|k| 0.5 * (x[k] + y[k]));
+        let slope = |x: &[f64; 3], y: &[f64; 3]| [0, 1, 2].map(|k| (y[k] - x[k]) / dt);
+        let at = a.t_ns;
+        assert_all_close(
+            &fd,
+            &mean(&a.body_rate, &b.body_rate),
+            rate_tol,
+            &format!("rate at {at}"),
+        );
+        let (accel, fd_accel) = (
+            mean(&a.angular_accel, &b.angular_accel),
+            slope(&a.body_rate, &b.body_rate),
+        );
+        assert_all_close(
+            &fd_accel,
+            &accel,
+            accel_tol,
+            &format!("angular accel at {at}"),
+        );
+        let (lin, fd_lin) = (
+            mean(&a.accel_world, &b.accel_world),
+            slope(&a.velocity, &b.velocity),
+        );
+        assert_all_close(&fd_lin, &lin, accel_tol, &format!("accel at {at}"));
     }
 }
 

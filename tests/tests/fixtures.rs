@@ -1,7 +1,7 @@
 //! The scenes in `hil-fixtures/scenes/` validate, run, and do what their names promise.
 
 use margemu::motion::Motion;
-use margemu::run::run;
+use margemu::run::collect;
 use margemu::scene::{MotionMode, Scene};
 use margemu::truth::Truth;
 use margemu_tests::fixture_scene;
@@ -11,15 +11,7 @@ fn load(name: &str) -> Scene {
 }
 
 fn truths(scene: &Scene) -> Vec<Truth> {
-    let mut out = Vec::new();
-    run(
-        scene,
-        |t: &Truth| -> Result<(), ()> { Ok(out.push(*t)) },
-        |_, _| {},
-    )
-    .unwrap()
-    .unwrap();
-    out
+    collect(scene).unwrap()
 }
 
 fn finite(t: &Truth) -> bool {
@@ -39,9 +31,7 @@ fn finite(t: &Truth) -> bool {
 }
 
 fn max_abs(ts: &[Truth], f: impl Fn(&Truth) -> [f64; 3]) -> f64 {
-    ts.iter()
-        .flat_map(|t| f(t))
-        .fold(0.0, |m, v| m.max(v.abs()))
+    ts.iter().flat_map(f).fold(0.0, |m, v| m.max(v.abs()))
 }
 
 #[test]

@@ -36,7 +36,11 @@ pub fn overlapping(y: &[f64], rate: f64) -> Vec<AllanPoint> {
                 acc += d * d;
             }
             let tau = m as f64 * tau0;
-            AllanPoint { tau, adev: (acc / (2.0 * tau * tau * terms as f64)).sqrt(), terms }
+            AllanPoint {
+                tau,
+                adev: (acc / (2.0 * tau * tau * terms as f64)).sqrt(),
+                terms,
+            }
         })
         .collect()
 }
@@ -57,7 +61,9 @@ fn cluster_sizes(max: usize) -> Vec<usize> {
 
 /// The Allan deviation at `tau`, interpolated log-log between the nearest points.
 pub fn at(points: &[AllanPoint], tau: f64) -> Option<f64> {
-    let i = points.windows(2).position(|w| w[0].tau <= tau && tau <= w[1].tau)?;
+    let i = points
+        .windows(2)
+        .position(|w| w[0].tau <= tau && tau <= w[1].tau)?;
     let (a, b) = (points[i], points[i + 1]);
     let w = (tau / a.tau).ln() / (b.tau / a.tau).ln();
     Some((a.adev.ln() * (1.0 - w) + b.adev.ln() * w).exp())
@@ -78,7 +84,10 @@ mod tests {
         let one = at(&points, 1.0).unwrap();
         assert!((one / density - 1.0).abs() < 0.05, "ADEV(1 s) = {one}");
         let ten = at(&points, 10.0).unwrap();
-        assert!((ten / (density / 10f64.sqrt()) - 1.0).abs() < 0.15, "ADEV(10 s) = {ten}");
+        assert!(
+            (ten / (density / 10f64.sqrt()) - 1.0).abs() < 0.15,
+            "ADEV(10 s) = {ten}"
+        );
         assert!(points.last().unwrap().tau <= 200.0 + 1e-9);
     }
 

@@ -44,7 +44,9 @@ fn ensure_font() -> Result<(), PlotError> {
     use std::sync::OnceLock;
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
-        let candidates = std::env::var("MARGEMU_FONT").into_iter().chain(FONT_PATHS.iter().map(|s| s.to_string()));
+        let candidates = std::env::var("MARGEMU_FONT")
+            .into_iter()
+            .chain(FONT_PATHS.iter().map(|s| s.to_string()));
         for path in candidates {
             if let Ok(bytes) = std::fs::read(&path) {
                 let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
@@ -58,16 +60,26 @@ fn ensure_font() -> Result<(), PlotError> {
     if ok {
         Ok(())
     } else {
-        Err(PlotError::NoFont { tried: FONT_PATHS.join(", ") })
+        Err(PlotError::NoFont {
+            tried: FONT_PATHS.join(", "),
+        })
     }
 }
 
 /// Draws the Allan deviation and the PSD of `name` to `path` (.png or .svg).
 pub fn noise(path: &Path, name: &str, allan: &[AllanPoint], psd: &Psd) -> Result<(), PlotError> {
     ensure_font()?;
-    let fail = |e: String| PlotError::Draw { path: path.to_path_buf(), reason: e };
+    let fail = |e: String| PlotError::Draw {
+        path: path.to_path_buf(),
+        reason: e,
+    };
     let size = (900, 900);
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
         Some("png") => {
             let root = BitMapBackend::new(path, size).into_drawing_area();
             draw(&root, name, allan, psd).map_err(|e| fail(e.to_string()))?;
@@ -78,31 +90,62 @@ pub fn noise(path: &Path, name: &str, allan: &[AllanPoint], psd: &Psd) -> Result
             draw(&root, name, allan, psd).map_err(|e| fail(e.to_string()))?;
             root.present().map_err(|e| fail(e.to_string()))
         }
-        _ => Err(PlotError::UnknownFormat { path: path.to_path_buf() }),
+        _ => Err(PlotError::UnknownFormat {
+            path: path.to_path_buf(),
+        }),
     }
 }
 
 type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
-fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, name: &str, allan: &[AllanPoint], psd: &Psd) -> DrawResult<DB> {
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    name: &str,
+    allan: &[AllanPoint],
+    psd: &Psd,
+) -> DrawResult<DB> {
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(450);
     let range = |vals: &mut dyn Iterator<Item = f64>| {
-        let (lo, hi) = vals.filter(|v| *v > 0.0 && v.is_finite()).fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
-        if lo.is_finite() { (lo / 1.5, hi * 1.5) } else { (1e-12, 1.0) }
+        let (lo, hi) = vals
+            .filter(|v| *v > 0.0 && v.is_finite())
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        if lo.is_finite() {
+            (lo / 1.5, hi * 1.5)
+        } else {
+            (1e-12, 1.0)
+        }
     };
     let (t_lo, t_hi) = range(&mut allan.iter().map(|p| p.tau));
     let (a_lo, a_hi) = range(&mut allan.iter().map(|p| p.adev));
     let mut chart = ChartBuilder::on(&top)
-        .caption(format!("{name}: overlapping Allan deviation"), ("sans-serif", 22))
+        .caption(
+            format!("{name}: overlapping Allan deviation"),
+            ("sans-serif", 22),
+        )
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
         .build_cartesian_2d((t_lo..t_hi).log_scale(), (a_lo..a_hi).log_scale())?;
-    chart.configure_mesh().x_desc("τ (s)").y_desc("σ(τ)").draw()?;
-    chart.draw_series(LineSeries::new(allan.iter().map(|p| (p.tau, p.adev)), &BLUE))?;
-    let points: Vec<(f64, f64)> =
-        psd.frequency.iter().zip(&psd.density).skip(1).map(|(f, d)| (*f, *d)).filter(|(_, d)| *d > 0.0).collect();
+    chart
+        .configure_mesh()
+        .x_desc("τ (s)")
+        .y_desc("σ(τ)")
+        .draw()?;
+    chart.draw_series(LineSeries::new(
+        allan.iter().map(|p| (p.tau, p.adev)),
+        &BLUE,
+    ))?;
+    let points: Vec<(f64, f64)> = psd
+        .frequency
+        .iter()
+        .zip(&psd.density)
+        .skip(1)
+        .map(|(f, d)| (*f, *d))
+        .filter(|(_, d)| *d > 0.0)
+        .collect();
     let (f_lo, f_hi) = range(&mut points.iter().map(|p| p.0));
     let (d_lo, d_hi) = range(&mut points.iter().map(|p| p.1));
     let mut chart = ChartBuilder::on(&bottom)
@@ -111,7 +154,11 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, name: &str, allan: &[
         .x_label_area_size(40)
         .y_label_area_size(70)
         .build_cartesian_2d((f_lo..f_hi).log_scale(), (d_lo..d_hi).log_scale())?;
-    chart.configure_mesh().x_desc("f (Hz)").y_desc("unit²/Hz").draw()?;
+    chart
+        .configure_mesh()
+        .x_desc("f (Hz)")
+        .y_desc("unit²/Hz")
+        .draw()?;
     chart.draw_series(LineSeries::new(points, &RED))?;
     Ok(())
 }

@@ -47,12 +47,20 @@ pub fn welch(y: &[f64], rate: f64, len: usize) -> Psd {
         .iter()
         .enumerate()
         .map(|(i, a)| {
-            let one_sided = if i == 0 || (len % 2 == 0 && i == bins - 1) { 1.0 } else { 2.0 };
+            let one_sided = if i == 0 || (len % 2 == 0 && i == bins - 1) {
+                1.0
+            } else {
+                2.0
+            };
             a * scale * one_sided
         })
         .collect();
     let frequency = (0..bins).map(|i| i as f64 * rate / len as f64).collect();
-    Psd { frequency, density, segments }
+    Psd {
+        frequency,
+        density,
+        segments,
+    }
 }
 
 impl Psd {
@@ -92,7 +100,9 @@ mod tests {
     #[test]
     fn a_sine_puts_its_variance_in_one_bin() {
         let rate = 1000.0;
-        let y: Vec<f64> = (0..1 << 16).map(|k| 2.0 * (2.0 * std::f64::consts::PI * 125.0 * k as f64 / rate).sin()).collect();
+        let y: Vec<f64> = (0..1 << 16)
+            .map(|k| 2.0 * (2.0 * std::f64::consts::PI * 125.0 * k as f64 / rate).sin())
+            .collect();
         let psd = welch(&y, rate, 1024);
         let df = rate / 1024.0;
         let variance: f64 = psd.density.iter().sum::<f64>() * df;

@@ -104,7 +104,9 @@ fn normalized_design(overshoot: f64, pole_ratio: f64, margin: Option<f64>) -> (f
     use std::collections::HashMap;
     use std::sync::{Mutex, OnceLock};
     type Key = (u64, u64, Option<u64>);
-    static MEMO: OnceLock<Mutex<HashMap<Key, (f64, f64, f64)>>> = OnceLock::new();
+    /// ζ, normalized overshoot, normalized settling time.
+    type Normalized = (f64, f64, f64);
+    static MEMO: OnceLock<Mutex<HashMap<Key, Normalized>>> = OnceLock::new();
     let key = (
         overshoot.to_bits(),
         pole_ratio.to_bits(),

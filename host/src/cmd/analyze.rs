@@ -24,14 +24,31 @@ pub enum Cmd {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let Cmd::Noise { file, column, segment, plot: plot_path } = self;
+        let Cmd::Noise {
+            file,
+            column,
+            segment,
+            plot: plot_path,
+        } = self;
         let series = Series::from_csv(&file, &column)?;
         let n = series.values.len();
         let mean = series.values.iter().sum::<f64>() / n as f64;
-        let var = series.values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
-        println!("{}: column `{column}`, {n} samples at {} Hz", file.display(), series.rate);
+        let var = series
+            .values
+            .iter()
+            .map(|v| (v - mean) * (v - mean))
+            .sum::<f64>()
+            / (n - 1) as f64;
+        println!(
+            "{}: column `{column}`, {n} samples at {} Hz",
+            file.display(),
+            series.rate
+        );
         println!("mean {mean:.6e}, standard deviation {:.6e}", var.sqrt());
-        println!("white-noise density from the standard deviation (σ/√fs): {:.6e} /√Hz", var.sqrt() / series.rate.sqrt());
+        println!(
+            "white-noise density from the standard deviation (σ/√fs): {:.6e} /√Hz",
+            var.sqrt() / series.rate.sqrt()
+        );
         let points = allan::overlapping(&series.values, series.rate);
         println!("\n{:>12} {:>14} {:>10}", "tau (s)", "adev", "terms");
         for p in &points {
@@ -42,13 +59,25 @@ impl Cmd {
         }
         let spectrum = psd::welch(&series.values, series.rate, segment);
         let nyquist = series.rate / 2.0;
-        println!("\nWelch PSD: {} segments of {segment} samples, {:.4} Hz resolution", spectrum.segments, series.rate / segment as f64);
+        println!(
+            "\nWelch PSD: {} segments of {segment} samples, {:.4} Hz resolution",
+            spectrum.segments,
+            series.rate / segment as f64
+        );
         let edges = [0.0, 0.01, 0.1, 0.25, 0.5, 0.75, 1.0];
-        println!("{:>22} {:>14} {:>16}", "band (Hz)", "mean PSD", "density (/√Hz)");
+        println!(
+            "{:>22} {:>14} {:>16}",
+            "band (Hz)", "mean PSD", "density (/√Hz)"
+        );
         for w in edges.windows(2) {
             let (lo, hi) = (w[0] * nyquist, w[1] * nyquist);
             if let Some(level) = spectrum.mean_in(lo.max(series.rate / segment as f64), hi) {
-                println!("{:>10.3} – {:<9.3} {level:>14.6e} {:>16.6e}", lo, hi, white_density_from_psd(level));
+                println!(
+                    "{:>10.3} – {:<9.3} {level:>14.6e} {:>16.6e}",
+                    lo,
+                    hi,
+                    white_density_from_psd(level)
+                );
             }
         }
         if let Some(path) = plot_path {
