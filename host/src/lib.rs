@@ -14,6 +14,7 @@
 
 pub mod analysis;
 pub mod bench;
+pub mod csv_column;
 pub mod motion;
 pub mod output;
 pub mod perf;

@@ -64,31 +64,24 @@ pub fn welch(y: &[f64], rate: f64, len: usize) -> Psd {
 }
 
 impl Psd {
+    /// Densities of the bins in `[lo, hi]` Hz.
+    fn band(&self, lo: f64, hi: f64) -> Vec<f64> {
+        let bins = self.frequency.iter().zip(&self.density);
+        bins.filter(|(f, _)| (lo..=hi).contains(*f))
+            .map(|(_, d)| *d)
+            .collect()
+    }
+
     /// Median density over `[lo, hi]` Hz (robust level of a flat band).
     pub fn median_in(&self, lo: f64, hi: f64) -> Option<f64> {
-        let mut band: Vec<f64> = self
-            .frequency
-            .iter()
-            .zip(&self.density)
-            .filter(|(f, _)| (lo..=hi).contains(*f))
-            .map(|(_, d)| *d)
-            .collect();
-        if band.is_empty() {
-            return None;
-        }
+        let mut band = self.band(lo, hi);
         band.sort_by(f64::total_cmp);
-        Some(band[band.len() / 2])
+        band.get(band.len() / 2).copied()
     }
 
     /// Mean density over `[lo, hi]` Hz.
     pub fn mean_in(&self, lo: f64, hi: f64) -> Option<f64> {
-        let band: Vec<f64> = self
-            .frequency
-            .iter()
-            .zip(&self.density)
-            .filter(|(f, _)| (lo..=hi).contains(*f))
-            .map(|(_, d)| *d)
-            .collect();
+        let band = self.band(lo, hi);
         (!band.is_empty()).then(|| band.iter().sum::<f64>() / band.len() as f64)
     }
 }

@@ -4,43 +4,10 @@
 //! the first row the first value holds, after the last row the last value holds.
 
 use super::Derivatives;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A CSV reference file that could not be used.
-#[derive(Debug, thiserror::Error, docsplay::Display)]
-pub enum TableError {
-    /// {path}: cannot read: {source}
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// The I/O or CSV error.
-        #[source]
-        source: csv::Error,
-    },
-    /// {path}: no column `{column}` in the header (columns: {found})
-    MissingColumn {
-        /// The file.
-        path: PathBuf,
-        /// The missing column.
-        column: String,
-        /// The header's columns.
-        found: String,
-    },
-    /// {path}:{line}: {reason}
-    BadRow {
-        /// The file.
-        path: PathBuf,
-        /// 1-based line.
-        line: u64,
-        /// What is wrong.
-        reason: String,
-    },
-    /// {path}: needs at least one data row
-    Empty {
-        /// The file.
-        path: PathBuf,
-    },
-}
+pub use crate::csv_column::ColumnError as TableError;
 
 /// A time series `(t, y)` with optional spline second derivatives.
 #[derive(Clone, Debug)]
@@ -54,58 +21,7 @@ pub struct Table {
 impl Table {
     /// Loads column `column` against column `t` from `path`.
     pub fn load(path: &Path, column: &str) -> Result<Self, TableError> {
-        let read = |source| TableError::Read {
-            path: path.to_path_buf(),
-            source,
-        };
-        let mut reader = csv::ReaderBuilder::new()
-            .trim(csv::Trim::All)
-            .from_path(path)
-            .map_err(read)?;
-        let header = reader.headers().map_err(read)?.clone();
-        let find = |name: &str| {
-            header
-                .iter()
-                .position(|h| h == name)
-                .ok_or_else(|| TableError::MissingColumn {
-                    path: path.to_path_buf(),
-                    column: name.to_owned(),
-                    found: header.iter().collect::<Vec<_>>().join(", "),
-                })
-        };
-        let (ti, yi) = (find("t")?, find(column)?);
-        let (mut t, mut y) = (Vec::new(), Vec::new());
-        for record in reader.records() {
-            let record = record.map_err(read)?;
-            let line = record.position().map_or(0, |p| p.line());
-            let bad = |reason: String| TableError::BadRow {
-                path: path.to_path_buf(),
-                line,
-                reason,
-            };
-            let field = |i: usize, name: &str| -> Result<f64, TableError> {
-                let text = record.get(i).unwrap_or("");
-                let v: f64 = text
-                    .parse()
-                    .map_err(|_| bad(format!("`{name}` = {text:?} is not a number")))?;
-                if v.is_finite() {
-                    Ok(v)
-                } else {
-                    Err(bad(format!("`{name}` = {text} is not finite")))
-                }
-            };
-            let (tv, yv) = (field(ti, "t")?, field(yi, column)?);
-            if t.last().is_some_and(|&last| tv <= last) {
-                return Err(bad(format!("t = {tv} does not increase")));
-            }
-            t.push(tv);
-            y.push(yv);
-        }
-        if t.is_empty() {
-            return Err(TableError::Empty {
-                path: path.to_path_buf(),
-            });
-        }
+        let (t, y) = crate::csv_column::read::<f64>(path, "t", column, 1)?;
         Ok(Self {
             t,
             y,
@@ -217,25 +133,5 @@ mod tests {
         assert_relative_eq!(v, (3.015f64).sin(), epsilon = 1e-8);
         assert_relative_eq!(d, 3.0 * (3.015f64).cos(), epsilon = 1e-5);
         assert_relative_eq!(dd, -9.0 * (3.015f64).sin(), epsilon = 1e-3);
-    }
-
-    #[test]
-    fn bad_rows_name_their_line() {
-        let dir = std::env::temp_dir().join(format!("margemu-table-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("bad.csv");
-        std::fs::write(&path, "t,z\n0,1\n0.5,oops\n").unwrap();
-        let err = Table::load(&path, "z").unwrap_err().to_string();
-        assert!(err.ends_with(":3: `z` = \"oops\" is not a number"), "{err}");
-        std::fs::write(&path, "t,z\n0,1\n0,2\n").unwrap();
-        assert!(Table::load(&path, "z")
-            .unwrap_err()
-            .to_string()
-            .contains(":3: t = 0 does not increase"));
-        let err = Table::load(&path, "q").unwrap_err().to_string();
-        assert!(
-            err.contains("no column `q` in the header (columns: t, z)"),
-            "{err}"
-        );
     }
 }
