@@ -88,10 +88,9 @@ impl SampleClock {
 
 fn reduce(a: u64, b: u64) -> (u64, u64) {
     let g = gcd(a, b);
-    if g == 0 {
-        (a, b)
-    } else {
-        (a / g, b / g)
+    match (a.checked_div(g), b.checked_div(g)) {
+        (Some(x), Some(y)) => (x, y),
+        _ => (a, b),
     }
 }
 
