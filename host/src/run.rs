@@ -2,6 +2,7 @@
 //! and hands it to a sink ([`run`]), or writes the run directory ([`simulate_to_dir`]).
 
 use crate::bench::{pid::Design, FrictionEvent};
+use crate::marg::{MargSim, MargWriter};
 use crate::motion::Motion;
 use crate::output::{TruthWriter, TRUTH_COLUMNS};
 use crate::reference::ReferenceError;
@@ -17,6 +18,8 @@ use std::path::{Path, PathBuf};
 pub enum RunError {
     /// a joint reference could not be built
     Reference(#[from] ReferenceError),
+    /// the sensor model refused the scene: {0}
+    Model(margemu_model::Error),
     /// cannot write {path}
     Write {
         /// The file.
@@ -94,23 +97,48 @@ pub fn collect(scene: &Scene) -> Result<Vec<Truth>, ReferenceError> {
     Ok(out)
 }
 
-/// Runs `scene` and writes `dir/meta.toml` and `dir/truth.csv` (creating `dir`).
+/// Runs `scene` and writes `dir/meta.toml`, `dir/truth.csv`, `dir/marg.csv` and, when the
+/// scene has a perturbation, `dir/perturbation.csv` (creating `dir`).
 pub fn simulate_to_dir(
     scene: &Scene,
     dir: &Path,
     progress: impl FnMut(u64, u64),
 ) -> Result<RunSummary, RunError> {
-    let write_err = |path: PathBuf| move |source| RunError::Write { path, source };
-    std::fs::create_dir_all(dir).map_err(write_err(dir.to_path_buf()))?;
+    let write_err = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| RunError::Write { path, source }
+    };
+    std::fs::create_dir_all(dir).map_err(write_err(dir))?;
     let meta_path = dir.join("meta.toml");
-    std::fs::write(&meta_path, metadata(scene)).map_err(write_err(meta_path.clone()))?;
-    let truth_path = dir.join("truth.csv");
-    let file = File::create(&truth_path).map_err(write_err(truth_path.clone()))?;
-    let mut writer = TruthWriter::new(BufWriter::with_capacity(1 << 20, file))
-        .map_err(write_err(truth_path.clone()))?;
-    let summary =
-        run(scene, |t| writer.write(t), progress)?.map_err(write_err(truth_path.clone()))?;
-    writer.finish().map_err(write_err(truth_path))?;
+    std::fs::write(&meta_path, metadata(scene)).map_err(write_err(&meta_path))?;
+    let mut marg = MargSim::new(scene).map_err(RunError::Model)?;
+    let create = |name: &str| -> Result<BufWriter<File>, RunError> {
+        let path = dir.join(name);
+        let file = File::create(&path).map_err(write_err(&path))?;
+        Ok(BufWriter::with_capacity(1 << 20, file))
+    };
+    let (truth_path, marg_path) = (dir.join("truth.csv"), dir.join("marg.csv"));
+    let mut truth_out = TruthWriter::new(create("truth.csv")?).map_err(write_err(&truth_path))?;
+    let pert_out = if marg.has_perturbation() {
+        Some(create("perturbation.csv")?)
+    } else {
+        None
+    };
+    let mut marg_out =
+        MargWriter::new(create("marg.csv")?, pert_out).map_err(write_err(&marg_path))?;
+    let sink = |t: &Truth| -> Result<(), RunError> {
+        let failed = |path: &PathBuf, source| RunError::Write {
+            path: path.clone(),
+            source,
+        };
+        truth_out.write(t).map_err(|e| failed(&truth_path, e))?;
+        marg_out
+            .write(&marg.sample(t))
+            .map_err(|e| failed(&marg_path, e))
+    };
+    let summary = run(scene, sink, progress)??;
+    truth_out.finish().map_err(write_err(&truth_path))?;
+    marg_out.finish().map_err(write_err(&marg_path))?;
     Ok(summary)
 }
 

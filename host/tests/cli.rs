@@ -40,7 +40,7 @@ fn same_scene_and_seed_give_byte_identical_files() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
-    for file in ["truth.csv", "meta.toml"] {
+    for file in ["truth.csv", "meta.toml", "marg.csv", "perturbation.csv"] {
         let (x, y) = (
             std::fs::read(a.join(file)).unwrap(),
             std::fs::read(b.join(file)).unwrap(),

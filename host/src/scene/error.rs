@@ -50,6 +50,13 @@ impl Violation {
         }
     }
 
+    pub fn at_keys(path: Vec<String>, reason: impl Into<String>) -> Self {
+        Self {
+            path: path.into_iter().map(PathPart::Key).collect(),
+            reason: reason.into(),
+        }
+    }
+
     pub fn index(mut self, i: usize) -> Self {
         self.path.push(PathPart::Index(i));
         self

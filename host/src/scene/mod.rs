@@ -3,7 +3,8 @@
 //! A scene names its duration, output rate and seed, how the plate moves ([`MotionMode`]: the
 //! closed-loop bench of the paper, prescribed kinematics, or a static pose), the bench parameters
 //! (Table 1 as defaults), the control requirements (Table 2 as defaults), the integrator, the
-//! reference magnetic field, and per joint a reference source. The schema is documented in the
+//! reference magnetic field, per joint a reference source, the sensor error terms and the
+//! magnetic perturbation ([`sensors`]). The schema is documented in the
 //! README ("Scene files"); every key is optional except `duration`, `rate` and `seed`.
 //!
 //! [`Scene::load`] reads, parses and validates a file. Every failure is a [`SceneError`] that
@@ -19,6 +20,7 @@
 
 mod error;
 mod schema;
+pub mod sensors;
 mod validate;
 
 pub use error::SceneError;

@@ -3,6 +3,7 @@
 //! Units are SI (m, s, rad, kg, N, N·m) except where a key's name says otherwise; arrays of six
 //! follow the joint order `x, y, z, roll, pitch, yaw` (the paper's `q = (x_b, y_b, z_b, φ, θ, ψ)`).
 
+use super::sensors::{PerturbationSpec, SensorsSpec};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -44,6 +45,12 @@ pub struct SceneSpec {
     /// Reference source per joint, keyed by joint name; absent joints hold their initial value.
     #[serde(default)]
     pub joints: BTreeMap<String, SourceSpec>,
+    /// Sensor error terms (each off unless named).
+    #[serde(default)]
+    pub sensors: SensorsSpec,
+    /// Magnetic perturbation bursts; none when the table is absent.
+    #[serde(default)]
+    pub perturbation: Option<PerturbationSpec>,
 }
 
 /// How the plate's motion is produced; a scene pays only for the mode it names.

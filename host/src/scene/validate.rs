@@ -42,11 +42,70 @@ pub(crate) fn check(spec: &SceneSpec, _path: &Path) -> Result<Checked, Violation
     for (name, source) in &spec.joints {
         check_joint(name, source, spec.motion)?;
     }
+    check_sensors(spec)?;
     Ok(Checked {
         clock,
         duration_ns,
         step_ns,
     })
+}
+
+/// The sensor and perturbation sections: keys on the right sensor, and everything the model
+/// itself refuses (it validates its configuration once, at construction).
+fn check_sensors(spec: &SceneSpec) -> Check {
+    use margemu_model::perturbation::PerturbationPlan;
+    use margemu_model::sensor::Marg;
+    let sensors = &spec.sensors;
+    for (name, sensor) in [
+        ("gyro", &sensors.gyro),
+        ("accel", &sensors.accel),
+        ("mag", &sensors.mag),
+    ] {
+        if let Some(key) = sensor.foreign_keys(name) {
+            return Err(Violation::at(
+                &["sensors", name, key],
+                format!("does not apply to `{name}`"),
+            ));
+        }
+    }
+    if let Some(t) = &sensors.temperature {
+        all_finite(t, &["sensors", "temperature"])?;
+    }
+    Marg::new(&sensors.config(), spec.rate, spec.seed).map_err(model_violation)?;
+    if let Some(p) = &spec.perturbation {
+        use super::sensors::PlacementSpec;
+        if p.placement == PlacementSpec::Direction && p.direction.is_none() {
+            return Err(Violation::at(
+                &["perturbation", "placement"],
+                "`direction` placement needs `direction = [x, y, z]`",
+            ));
+        }
+        PerturbationPlan::new(&p.config(), spec.rate).map_err(model_violation)?;
+    }
+    Ok(())
+}
+
+/// A model error at the scene key it concerns.
+fn model_violation(e: margemu_model::Error) -> Violation {
+    use margemu_model::Error as E;
+    let keys: &[&str] = match e {
+        E::NonFiniteParameter { what }
+        | E::ParameterTooLarge { what }
+        | E::NegativeParameter { what }
+        | E::NonPositiveParameter { what } => {
+            return Violation::at_keys(super::sensors::key_path(what), e.to_string());
+        }
+        E::InvalidRate => &["rate"],
+        E::PerturbationWindowTooShort { .. } | E::PerturbationWindowTooLong => {
+            &["perturbation", "window"]
+        }
+        E::CutoffAboveNyquist => &["perturbation", "cutoff"],
+        E::ZeroAmplitudeRange | E::InvertedAmplitudeRange => &["perturbation", "amplitude"],
+        E::InvertedGapRange => &["perturbation", "gap"],
+        E::ZeroDirection => &["perturbation", "direction"],
+        _ => &["perturbation"],
+    };
+    Violation::at(keys, e.to_string())
 }
 
 fn check_bench(b: &BenchSpec) -> Check {

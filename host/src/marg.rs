@@ -1,0 +1,154 @@
+//! Raw MARG samples: the shared `model` crate driven by ground truth, exactly as the firmware
+//! will drive it, so the host predicts every sample the device emits bit for bit.
+//!
+//! Per output sample the body-frame truth is rounded to `f32`, the magnetic disturbance of the
+//! perturbation generator (if the scene has one) is added to the true field, and the sensor
+//! model of eq. 18 turns that into accelerometer, gyroscope and magnetometer readings.
+//!
+//! `marg.csv`: `t_ns,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z` in m/s², rad/s and
+//! the scene's field unit. `perturbation.csv`: `t_ns,mag_x,mag_y,mag_z`, the disturbance added
+//! to the true field per axis (written only when the scene has a `[perturbation]`).
+
+use crate::scene::Scene;
+use crate::truth::Truth;
+use margemu_model::perturbation::{Complex, Perturbation, PerturbationPlan};
+use margemu_model::sensor::{self, Marg, Sample};
+use std::io::{self, Write};
+
+/// Header of `marg.csv`.
+pub const MARG_COLUMNS: [&str; 10] = [
+    "t_ns", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z", "mag_x", "mag_y", "mag_z",
+];
+
+/// Header of `perturbation.csv`.
+pub const PERTURBATION_COLUMNS: [&str; 4] = ["t_ns", "mag_x", "mag_y", "mag_z"];
+
+/// The perturbation generator with host-owned buffers.
+type HostPerturbation = Perturbation<Vec<Complex>, Vec<f32>>;
+
+/// The sensor model of one scene, sample by sample.
+pub struct MargSim {
+    marg: Marg,
+    perturbation: Option<HostPerturbation>,
+    temperature: Option<[f64; 2]>,
+}
+
+/// One output sample of the sensor model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MargSample {
+    /// Latch instant.
+    pub t_ns: u64,
+    /// What the sensors read.
+    pub sample: Sample,
+    /// Disturbance added to the true field.
+    pub disturbance: [f32; 3],
+}
+
+impl MargSim {
+    /// The model of `scene` (already validated, so this fails only on a model it refused).
+    pub fn new(scene: &Scene) -> Result<Self, margemu_model::Error> {
+        let spec = &scene.spec;
+        let rate = scene.clock.hz();
+        let marg = Marg::new(&spec.sensors.config(), rate, spec.seed)?;
+        let perturbation = match &spec.perturbation {
+            None => None,
+            Some(p) => {
+                let plan = PerturbationPlan::new(&p.config(), rate)?;
+                let scratch = vec![Complex::default(); plan.scratch_len()];
+                let signal = vec![0.0f32; plan.signal_len()];
+                Some(Perturbation::new(&plan, spec.seed, scratch, signal)?)
+            }
+        };
+        Ok(Self {
+            marg,
+            perturbation,
+            temperature: spec.sensors.temperature,
+        })
+    }
+
+    /// Whether the scene has a perturbation generator.
+    pub fn has_perturbation(&self) -> bool {
+        self.perturbation.is_some()
+    }
+
+    /// The reading for the next output sample, whose truth is `t`.
+    pub fn sample(&mut self, t: &Truth) -> MargSample {
+        let disturbance = self.perturbation.as_mut().map_or([0.0; 3], |p| p.sample());
+        let f = |v: [f64; 3]| v.map(|x| x as f32);
+        let field = f(t.field_body);
+        let truth = sensor::Truth {
+            angular_rate: f(t.body_rate),
+            specific_force: f(t.specific_force),
+            magnetic_field: [0, 1, 2].map(|i| field[i] + disturbance[i]),
+            angular_acceleration: f(t.angular_accel),
+            temperature_c: self
+                .temperature
+                .map(|[start, slope]| (start + slope * t.t_ns as f64 * 1e-9) as f32),
+        };
+        MargSample {
+            t_ns: t.t_ns,
+            sample: self.marg.sample(&truth),
+            disturbance,
+        }
+    }
+}
+
+/// Writes `marg.csv` rows (and optionally `perturbation.csv` rows).
+pub struct MargWriter<W: Write> {
+    marg: W,
+    perturbation: Option<W>,
+    float: ryu::Buffer,
+}
+
+impl<W: Write> MargWriter<W> {
+    /// Writes the headers.
+    pub fn new(mut marg: W, mut perturbation: Option<W>) -> io::Result<Self> {
+        writeln!(marg, "{}", MARG_COLUMNS.join(","))?;
+        if let Some(p) = perturbation.as_mut() {
+            writeln!(p, "{}", PERTURBATION_COLUMNS.join(","))?;
+        }
+        Ok(Self {
+            marg,
+            perturbation,
+            float: ryu::Buffer::new(),
+        })
+    }
+
+    /// Writes one sample.
+    pub fn write(&mut self, s: &MargSample) -> io::Result<()> {
+        let values = s
+            .sample
+            .acc
+            .iter()
+            .chain(&s.sample.gyr)
+            .chain(&s.sample.mag);
+        write_row(&mut self.marg, &mut self.float, s.t_ns, values)?;
+        if let Some(p) = self.perturbation.as_mut() {
+            write_row(p, &mut self.float, s.t_ns, s.disturbance.iter())?;
+        }
+        Ok(())
+    }
+
+    /// Flushes both files.
+    pub fn finish(mut self) -> io::Result<()> {
+        self.marg.flush()?;
+        if let Some(p) = self.perturbation.as_mut() {
+            p.flush()?;
+        }
+        Ok(())
+    }
+}
+
+fn write_row<'a>(
+    out: &mut impl Write,
+    float: &mut ryu::Buffer,
+    t_ns: u64,
+    values: impl Iterator<Item = &'a f32>,
+) -> io::Result<()> {
+    write!(out, "{t_ns}")?;
+    for v in values {
+        out.write_all(b",")?;
+        out.write_all(float.format(*v).as_bytes())?;
+    }
+    out.write_all(b"\n")
+}
