@@ -113,9 +113,9 @@ struct Effort {
 }
 
 impl Joint {
-    /// A joint at rest at `q0`, stuck if it has static friction.
-    pub fn new(params: JointParams, q0: f64, r0: f64) -> Self {
-        let state = [q0, 0.0, 0.0, r0, 0.0];
+    /// A joint at rest at `q0` (its smoothed setpoint too), stuck if it has static friction.
+    pub fn new(params: JointParams, q0: f64) -> Self {
+        let state = [q0, 0.0, 0.0, q0, 0.0];
         Self {
             params,
             state,
@@ -308,7 +308,7 @@ mod tests {
     fn a_stuck_joint_breaks_away_only_past_the_threshold() {
         // Pure integral control on a unit error: the effort is 10·t, so with τ_s = 5 the joint
         // must stay put until t = 0.5 s and slide from the first step after.
-        let mut j = Joint::new(params(5.0), 0.0, 1.0);
+        let mut j = Joint::new(params(5.0), 0.0);
         let h = 1e-3;
         let mut slipped_at = None;
         for k in 0..1000 {
@@ -325,7 +325,7 @@ mod tests {
 
     #[test]
     fn without_stiction_the_state_machine_is_off() {
-        let mut j = Joint::new(params(0.0), 0.0, 1.0);
+        let mut j = Joint::new(params(0.0), 0.0);
         assert!(!j.is_stuck());
         for _ in 0..100 {
             assert_eq!(j.step(Method::Rk4, 1e-3, [1.0; 3]), None);
@@ -343,7 +343,7 @@ mod tests {
         };
         p.smoothing = Some((46.0, 0.869));
         for method in [Method::Rk4, Method::SemiImplicitEuler] {
-            let mut general = Joint::new(p, 0.1, 0.1);
+            let mut general = Joint::new(p, 0.1);
             let mut fast = general.clone();
             fast.prepare(method, 1e-3);
             assert!(fast.linear.is_some());
@@ -361,7 +361,7 @@ mod tests {
                 );
             }
             // A nonlinear joint keeps the general path.
-            let mut stuck = Joint::new(params(1.0), 0.0, 0.0);
+            let mut stuck = Joint::new(params(1.0), 0.0);
             stuck.prepare(method, 1e-3);
             assert!(stuck.linear.is_none());
         }
@@ -371,7 +371,7 @@ mod tests {
     fn a_clipped_effort_holds_the_integrator() {
         let mut p = params(0.0);
         p.limit = 1.0;
-        let mut j = Joint::new(p, 0.0, 1.0);
+        let mut j = Joint::new(p, 0.0);
         for _ in 0..1000 {
             j.step(Method::SemiImplicitEuler, 1e-3, [1.0; 3]);
         }

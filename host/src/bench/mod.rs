@@ -142,7 +142,7 @@ impl Bench {
                 smoothing,
             };
             let q0 = spec.bench.initial[i];
-            let mut joint = Joint::new(params, q0, q0);
+            let mut joint = Joint::new(params, q0);
             joint.prepare(spec.integrator.method, scene.step_ns as f64 * 1e-9);
             joint
         });
