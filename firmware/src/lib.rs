@@ -1,8 +1,14 @@
 //! Firmware library of margemu: the emulated chip (register file, SPI/I2C target state machines)
 //! and the link handler. It is `no_std` and host-testable; the board crates under `boards/` are
-//! thin binaries around it. The chip and link work land with issues 4 and 5.
+//! thin binaries around it.
+//!
+//! - [`chip`]: the emulated MARG chips behind the [`chip::SpiTarget`] and [`chip::I2cTarget`]
+//!   bus-target traits that a board's peripheral interrupts (or the host's embedded-hal
+//!   adapters) drive byte by byte.
 #![no_std]
 #![warn(missing_docs)]
+
+pub mod chip;
 
 pub use margemu_model as model;
 pub use margemu_protocol as protocol;

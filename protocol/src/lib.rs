@@ -1,13 +1,18 @@
 //! The host ↔ firmware link of margemu, and the register maps of the emulated chips.
 //!
-//! Layers, bottom up (filled in by the link work, issue 4):
-//! - **frame**: COBS framing with a CRC; a stream accumulator that returns outcomes as values;
-//! - **message**: handshake, configuration, sample batches, flow-control credits, telemetry;
-//! - **register map**: addresses, reset values and masks of each emulated chip.
+//! Layers, bottom up:
+//! - [`link`]: frames (COBS + CRC), the stream accumulator that returns outcomes as values, and
+//!   the messages (handshake, configuration, sample batches, flow control, telemetry);
+//! - [`regmap`]: addresses, reset values, masks and physical ↔ register conversions of each
+//!   emulated chip, shared by the firmware (which serves them) and the host (which predicts them).
 //!
-//! The crate is `no_std`, allocation-free, and never panics on any input.
+//! The crate is `no_std`, allocation-free, and never panics on any input. The bytes are written
+//! down in `docs/spec/`.
 #![no_std]
 #![warn(missing_docs)]
 
+pub mod link;
+pub mod regmap;
+
 /// Version of the link protocol spoken by this crate.
-pub const PROTOCOL_VERSION: u16 = 0;
+pub const PROTOCOL_VERSION: u16 = 1;

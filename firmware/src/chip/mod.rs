@@ -1,0 +1,54 @@
+//! Emulated MARG chips, seen from the bus as a target (peripheral) device.
+//!
+//! A chip is driven byte by byte, the way a microcontroller's SPI or I2C peripheral in target
+//! mode sees a transaction, so the same code serves a real board (from its interrupts) and the
+//! host (behind embedded-hal adapters, so third-party drivers run against it unmodified).
+//!
+//! **SPI timing contract.** SPI is full duplex: while the controller clocks byte *i* in on MOSI,
+//! the target shifts out the byte it loaded *before* byte *i* began. So [`SpiTarget::select`]
+//! returns the MISO byte of the first byte, and [`SpiTarget::exchange`] takes the MOSI byte just
+//! received and returns the MISO byte for the *next* byte, which a board must load into its TX
+//! register within one byte time (the response-time budget). Implementations never panic, on any
+//! sequence of calls.
+//!
+//! **I2C contract.** [`I2cTarget::start`] is a START or repeated START with a 7-bit address and
+//! direction; it returns whether the target acknowledges. Writes return ACK/NACK; reads return
+//! the byte the target drives; [`I2cTarget::stop`] ends the transaction. A target that did not
+//! acknowledge its address ignores the following bytes until the next START.
+
+/// The SPI target side of a chip (mode 0/3, MSB first), byte by byte.
+pub trait SpiTarget {
+    /// Chip select asserted: a transaction begins. Returns the MISO byte of its first byte.
+    fn select(&mut self) -> u8;
+    /// `mosi` was clocked in; returns the MISO byte for the next byte of the transaction.
+    fn exchange(&mut self, mosi: u8) -> u8;
+    /// Chip select released: the transaction ends.
+    fn deselect(&mut self);
+}
+
+/// The I2C target side of a chip (possibly answering several addresses, as the MPU-9250 does
+/// with the AK8963 in bypass mode).
+pub trait I2cTarget {
+    /// START or repeated START to 7-bit `address`, reading if `read`; returns ACK.
+    fn start(&mut self, address: u8, read: bool) -> bool;
+    /// A byte written by the controller; returns ACK.
+    fn write(&mut self, byte: u8) -> bool;
+    /// The next byte read by the controller.
+    fn read(&mut self) -> u8;
+    /// STOP.
+    fn stop(&mut self);
+}
+
+/// One physical sample as the chip's sensors would see it, in the chip's accel/gyro axes
+/// (the AK8963's own axis quirks are applied inside the chip model).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhysicalSample {
+    /// Specific force (m/s²).
+    pub acc: [f32; 3],
+    /// Angular rate (rad/s).
+    pub gyr: [f32; 3],
+    /// Magnetic field (µT).
+    pub mag: [f32; 3],
+    /// Die temperature (°C).
+    pub temp_c: f32,
+}
