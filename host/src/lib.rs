@@ -7,6 +7,7 @@
 //! - [`bench`](mod@bench): the closed-loop bench (eq. 5–17): joints, friction, PID synthesis, integrators;
 //! - [`motion`]: static, kinematic or bench motion, so a scene pays only for what it uses;
 //! - [`truth`]: ground truth of the plate (attitude, rates, specific force, field) per sample;
+//! - [`bus`]: embedded-hal 1.0 adapters (SPI, I2C, delay) that put the emulated chip under unmodified drivers;
 //! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
@@ -15,6 +16,7 @@
 
 pub mod analysis;
 pub mod bench;
+pub mod bus;
 pub mod csv_column;
 pub mod marg;
 pub mod motion;

@@ -1,7 +1,9 @@
 //! Helpers shared by the system tests in `tests/tests/`: where the fixtures live and how to run
-//! the `margemu` binary on them.
+//! the `margemu` binary on them; [`qemu`] builds the QEMU board firmware and boots it.
 
 use std::path::PathBuf;
+
+pub mod qemu;
 
 /// The workspace root.
 pub fn workspace_root() -> PathBuf {

@@ -15,6 +15,21 @@
 //! direction; it returns whether the target acknowledges. Writes return ACK/NACK; reads return
 //! the byte the target drives; [`I2cTarget::stop`] ends the transaction. A target that did not
 //! acknowledge its address ignores the following bytes until the next START.
+//!
+//! Chips:
+//! - [`Mpu9250`]: the InvenSense MPU-9250 (and its WHO_AM_I variants) with the [`Ak8963`]
+//!   magnetometer behind its auxiliary I2C master or in bypass mode;
+//! - [`Ak8963`] on its own, as an [`I2cTarget`].
+//!
+//! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
+
+mod ak8963;
+pub mod mpu9250;
+mod write_log;
+
+pub use ak8963::{Ak8963, MagSource};
+pub use mpu9250::{Config, Mpu9250, Variant};
+pub use write_log::{Bus, RegisterWrite, WriteLog};
 
 /// The SPI target side of a chip (mode 0/3, MSB first), byte by byte.
 pub trait SpiTarget {
