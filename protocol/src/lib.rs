@@ -14,5 +14,8 @@
 pub mod link;
 pub mod regmap;
 
+/// The crate's one error type (link framing, messages and their buffers).
+pub use link::Error;
+
 /// Version of the link protocol spoken by this crate.
 pub const PROTOCOL_VERSION: u16 = 1;

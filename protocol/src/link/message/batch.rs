@@ -1,0 +1,353 @@
+//! Batches of fixed-size items: register images and true kinematics (host → device), register
+//! writes (device → host).
+//!
+//! A batch borrows its items: when emitting, from the caller's slice ([`Items::from_slice`]);
+//! when parsed, from the frame's payload, validated once at parse time and decoded on access.
+//! Either way [`Items::iter`] yields the items by value and two batches compare equal when their
+//! items do.
+//!
+//! ```
+//! use margemu_protocol::link::{ImageBatch, Message, IMAGE_LEN};
+//! let images = [[1u8; IMAGE_LEN], [2u8; IMAGE_LEN]];
+//! let mut payload = [0u8; 8 + 2 * IMAGE_LEN];
+//! Message::Images(ImageBatch::new(40, &images)).emit(&mut payload)?;
+//! let Message::Images(batch) = Message::parse(0x10, &payload)? else { unreachable!() };
+//! assert_eq!(batch.first_index, 40);
+//! assert_eq!(batch.images.get(1), Some([2u8; IMAGE_LEN]));
+//! assert_eq!(batch.images.iter().count(), 2);
+//! # Ok::<(), margemu_protocol::link::Error>(())
+//! ```
+
+use core::fmt;
+
+use margemu_model::sensor::Truth;
+
+use crate::link::wire::{Reader, Writer};
+use crate::link::{Error, MAX_PAYLOAD_LEN};
+
+/// Bytes of one register image: the MPU-9250 data registers and the AK8963 block, laid out
+/// by [`crate::regmap::image`] (the link carries it as opaque bytes).
+pub use crate::regmap::image::IMAGE_LEN;
+
+/// One finished register image (see [`IMAGE_LEN`]).
+pub type Image = [u8; IMAGE_LEN];
+
+/// Bytes in one true-kinematics sample (13 binary32 values and a flags byte).
+pub const TRUTH_LEN: usize = 53;
+
+/// Most images in one [`ImageBatch`].
+pub const MAX_IMAGES_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 8) / IMAGE_LEN;
+/// Most samples in one [`KinematicsBatch`].
+pub const MAX_KINEMATICS_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 8) / TRUTH_LEN;
+/// Most entries in one [`RegisterWriteBatch`].
+pub const MAX_REGISTER_WRITES_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 4) / RegisterWrite::LEN;
+
+/// A fixed-size item of a batch.
+pub trait WireItem: Sized + Copy {
+    /// Its size on the wire.
+    const LEN: usize;
+    /// Decodes one item from exactly [`LEN`](Self::LEN) bytes.
+    fn parse(bytes: &[u8]) -> Result<Self, Error>;
+    /// Encodes it ([`LEN`](Self::LEN) bytes).
+    fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error>;
+    /// Checks one encoded item; by default by parsing it.
+    fn validate(bytes: &[u8]) -> Result<(), Error> {
+        Self::parse(bytes).map(drop)
+    }
+}
+
+impl WireItem for Image {
+    const LEN: usize = IMAGE_LEN;
+    fn parse(bytes: &[u8]) -> Result<Self, Error> {
+        Reader::new(bytes).array()
+    }
+    fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.bytes(self)
+    }
+    fn validate(_: &[u8]) -> Result<(), Error> {
+        Ok(())
+    }
+}
+
+/// Flags byte of a kinematics sample: the temperature is present.
+const TEMPERATURE_PRESENT: u8 = 0x01;
+
+impl WireItem for Truth {
+    const LEN: usize = TRUTH_LEN;
+    fn parse(bytes: &[u8]) -> Result<Self, Error> {
+        let mut r = Reader::new(bytes);
+        let (w, f, m, dw) = (r.f32s()?, r.f32s()?, r.f32s()?, r.f32s()?);
+        let t = r.u32()?;
+        let temperature_c = match r.u8()? {
+            TEMPERATURE_PRESENT => Some(f32::from_bits(t)),
+            0 if t == 0 => None,
+            _ => return Err(Error::InvalidValue),
+        };
+        r.finish()?;
+        Ok(Truth {
+            angular_rate: w,
+            specific_force: f,
+            magnetic_field: m,
+            angular_acceleration: dw,
+            temperature_c,
+        })
+    }
+    fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.f32s(&self.angular_rate)?;
+        w.f32s(&self.specific_force)?;
+        w.f32s(&self.magnetic_field)?;
+        w.f32s(&self.angular_acceleration)?;
+        w.f32(self.temperature_c.unwrap_or(0.0))?;
+        w.u8(if self.temperature_c.is_some() {
+            TEMPERATURE_PRESENT
+        } else {
+            0
+        })
+    }
+}
+
+code_enum! {
+    /// The bus a register write arrived on.
+    pub enum Bus {
+        /// SPI (the address field is 0).
+        Spi = 0,
+        /// I2C (the address field is the 7-bit target address).
+        I2c = 1,
+        /// The MPU-9250's auxiliary I2C master, writing to the AK8963 on behalf of the device
+        /// under test (the address field is the slave address).
+        AuxMaster = 2,
+    }
+}
+
+/// One register write made by the device under test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RegisterWrite {
+    /// Device scene time of the write, ns.
+    pub time_ns: u64,
+    /// Bus.
+    pub bus: Bus,
+    /// 7-bit I2C address (0 on SPI).
+    pub address: u8,
+    /// Register address.
+    pub register: u8,
+    /// Value written.
+    pub value: u8,
+}
+
+impl WireItem for RegisterWrite {
+    const LEN: usize = 12;
+    fn parse(bytes: &[u8]) -> Result<Self, Error> {
+        let mut r = Reader::new(bytes);
+        let write = Self {
+            time_ns: r.u64()?,
+            bus: Bus::read(&mut r)?,
+            address: r.u8()?,
+            register: r.u8()?,
+            value: r.u8()?,
+        };
+        r.finish()?;
+        Ok(write)
+    }
+    fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u64(self.time_ns)?;
+        w.bytes(&[self.bus as u8, self.address, self.register, self.value])
+    }
+}
+
+/// The items of a batch: the caller's slice, or a validated payload region.
+pub struct Items<'a, T> {
+    repr: ItemsRepr<'a, T>,
+}
+
+enum ItemsRepr<'a, T> {
+    Values(&'a [T]),
+    Wire(&'a [u8]),
+}
+
+impl<T> Clone for Items<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Items<'_, T> {}
+impl<T> Clone for ItemsRepr<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for ItemsRepr<'_, T> {}
+
+impl<'a, T: WireItem> Items<'a, T> {
+    /// Items to emit.
+    pub const fn from_slice(values: &'a [T]) -> Self {
+        Self {
+            repr: ItemsRepr::Values(values),
+        }
+    }
+
+    /// Takes every remaining byte of `r` as whole, valid items.
+    fn parse(r: &mut Reader<'a>) -> Result<Self, Error> {
+        let bytes = r.bytes(r.remaining().len())?;
+        if bytes.len() % T::LEN != 0 {
+            return Err(Error::PayloadTooLong);
+        }
+        bytes.chunks_exact(T::LEN).try_for_each(T::validate)?;
+        Ok(Self {
+            repr: ItemsRepr::Wire(bytes),
+        })
+    }
+
+    fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        match self.repr {
+            ItemsRepr::Values(v) => v.iter().try_for_each(|x| x.emit(w)),
+            ItemsRepr::Wire(b) => w.bytes(b),
+        }
+    }
+
+    /// The number of items.
+    pub fn len(&self) -> usize {
+        match self.repr {
+            ItemsRepr::Values(v) => v.len(),
+            ItemsRepr::Wire(b) => b.len() / T::LEN,
+        }
+    }
+
+    /// Whether there is no item.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Their size on the wire.
+    pub fn buffer_len(&self) -> usize {
+        self.len() * T::LEN
+    }
+
+    /// Item `i`.
+    pub fn get(&self, i: usize) -> Option<T> {
+        match self.repr {
+            ItemsRepr::Values(v) => v.get(i).copied(),
+            ItemsRepr::Wire(b) => {
+                let at = i.checked_mul(T::LEN)?;
+                T::parse(b.get(at..at.checked_add(T::LEN)?)?).ok()
+            }
+        }
+    }
+
+    /// The items, in order.
+    pub fn iter(&self) -> impl Iterator<Item = T> + 'a {
+        let items = *self;
+        (0..self.len()).filter_map(move |i| items.get(i))
+    }
+}
+
+impl<T: WireItem + PartialEq> PartialEq for Items<'_, T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.len() == other.len() && self.iter().eq(other.iter())
+    }
+}
+
+impl<T: WireItem + fmt::Debug> fmt::Debug for Items<'_, T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+/// Host → device: finished register images for consecutive samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageBatch<'a> {
+    /// Index of the first image; image `k` is sample `first_index + k`.
+    pub first_index: u64,
+    /// The images, at most [`MAX_IMAGES_PER_BATCH`].
+    pub images: Items<'a, Image>,
+}
+
+/// Host → device: true kinematics (at the configured truth rate) for consecutive samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KinematicsBatch<'a> {
+    /// Index of the first sample (at the truth rate); sample `k` is `first_index + k`.
+    pub first_index: u64,
+    /// The samples, at most [`MAX_KINEMATICS_PER_BATCH`].
+    pub samples: Items<'a, Truth>,
+}
+
+/// Device → host: register writes of the device under test, oldest first.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RegisterWriteBatch<'a> {
+    /// Writes lost since the previous batch because the device's log was full.
+    pub dropped: u32,
+    /// The writes, at most [`MAX_REGISTER_WRITES_PER_BATCH`].
+    pub writes: Items<'a, RegisterWrite>,
+}
+
+impl<'a> ImageBatch<'a> {
+    /// A batch of `images` starting at sample `first_index`.
+    pub const fn new(first_index: u64, images: &'a [Image]) -> Self {
+        Self {
+            first_index,
+            images: Items::from_slice(images),
+        }
+    }
+    pub(crate) fn parse(r: &mut Reader<'a>) -> Result<Self, Error> {
+        let first_index = r.u64()?;
+        let images = Items::parse(r)?;
+        Ok(Self {
+            first_index,
+            images,
+        })
+    }
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u64(self.first_index)?;
+        self.images.emit(w)
+    }
+    pub(crate) fn buffer_len(&self) -> usize {
+        8 + self.images.buffer_len()
+    }
+}
+
+impl<'a> KinematicsBatch<'a> {
+    /// A batch of `samples` starting at truth index `first_index`.
+    pub const fn new(first_index: u64, samples: &'a [Truth]) -> Self {
+        Self {
+            first_index,
+            samples: Items::from_slice(samples),
+        }
+    }
+    pub(crate) fn parse(r: &mut Reader<'a>) -> Result<Self, Error> {
+        let first_index = r.u64()?;
+        let samples = Items::parse(r)?;
+        Ok(Self {
+            first_index,
+            samples,
+        })
+    }
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u64(self.first_index)?;
+        self.samples.emit(w)
+    }
+    pub(crate) fn buffer_len(&self) -> usize {
+        8 + self.samples.buffer_len()
+    }
+}
+
+impl<'a> RegisterWriteBatch<'a> {
+    /// A batch of `writes`, after `dropped` lost ones.
+    pub const fn new(dropped: u32, writes: &'a [RegisterWrite]) -> Self {
+        Self {
+            dropped,
+            writes: Items::from_slice(writes),
+        }
+    }
+    pub(crate) fn parse(r: &mut Reader<'a>) -> Result<Self, Error> {
+        let dropped = r.u32()?;
+        let writes = Items::parse(r)?;
+        Ok(Self { dropped, writes })
+    }
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u32(self.dropped)?;
+        self.writes.emit(w)
+    }
+    pub(crate) fn buffer_len(&self) -> usize {
+        4 + self.writes.buffer_len()
+    }
+}

@@ -1,0 +1,292 @@
+//! Session messages: the handshake ([`Hello`], [`HelloAck`]), [`Start`], [`Reset`] and
+//! [`ErrorReport`], with the capability sets the device advertises.
+//!
+//! ```
+//! use margemu_protocol::link::{Capabilities, Chips, Modes};
+//! let caps = Capabilities { chips: Chips::MPU9250 | Chips::MPU6500, ..Capabilities::default() };
+//! assert!(caps.chips.contains(Chips::for_who_am_i(0x71).unwrap()));
+//! assert!(!caps.modes.contains(Modes::MODEL));
+//! ```
+
+use crate::link::wire::{Reader, Writer};
+use crate::link::Error;
+
+/// Length of the device identifier in [`HelloAck`] (an MCU unique ID, zero-padded).
+pub const DEVICE_ID_LEN: usize = 16;
+
+flags! {
+    /// The chip variants a device can emulate, by WHO_AM_I.
+    pub struct Chips {
+        /// MPU-9250, WHO_AM_I 0x71.
+        const MPU9250 = 0;
+        /// MPU-9255, WHO_AM_I 0x73.
+        const MPU9255 = 1;
+        /// MPU-6500 (no magnetometer), WHO_AM_I 0x70.
+        const MPU6500 = 2;
+        /// The 0x68 variant (MPU-9150/MPU-6050 register map subset), WHO_AM_I 0x68.
+        const WHO_AM_I_68 = 3;
+    }
+}
+
+impl Chips {
+    /// The flag of the chip that answers WHO_AM_I with `who_am_i`.
+    pub fn for_who_am_i(who_am_i: u8) -> Option<Self> {
+        Some(match who_am_i {
+            0x71 => Self::MPU9250,
+            0x73 => Self::MPU9255,
+            0x70 => Self::MPU6500,
+            0x68 => Self::WHO_AM_I_68,
+            _ => return None,
+        })
+    }
+}
+
+flags! {
+    /// The sample sources a device supports (see [`Source`](super::Source)).
+    pub struct Modes {
+        /// (a) finished register images from the host.
+        const IMAGES = 0;
+        /// (b) true kinematics from the host and the sensor model on the device.
+        const MODEL = 1;
+    }
+}
+
+flags! {
+    /// The buses on which the device serves the emulated chip.
+    pub struct Buses {
+        /// SPI target.
+        const SPI = 0;
+        /// I2C target.
+        const I2C = 1;
+    }
+}
+
+/// What a device can do, sent in [`HelloAck`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Capabilities {
+    /// Emulated chip variants.
+    pub chips: Chips,
+    /// Sample sources.
+    pub modes: Modes,
+    /// Buses.
+    pub buses: Buses,
+    /// The most samples the device accepts in one batch message.
+    pub max_batch: u16,
+    /// The device's sample buffer, in samples of the configured source.
+    pub buffer_capacity: u32,
+}
+
+/// A firmware version, semantic.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FirmwareVersion {
+    /// Major.
+    pub major: u8,
+    /// Minor.
+    pub minor: u8,
+    /// Patch.
+    pub patch: u8,
+}
+
+/// Host → device: opens (or reopens) a session. The device answers [`HelloAck`] and returns to
+/// the idle state, dropping any configuration and buffered samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Hello {
+    /// The host's [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION).
+    pub protocol_version: u16,
+    /// A host-chosen session number, echoed in [`HelloAck`].
+    pub session: u32,
+}
+
+impl Hello {
+    /// Payload length.
+    pub const LEN: usize = 6;
+
+    pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
+        Ok(Self {
+            protocol_version: r.u16()?,
+            session: r.u32()?,
+        })
+    }
+
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u16(self.protocol_version)?;
+        w.u32(self.session)
+    }
+}
+
+/// Device → host: answers [`Hello`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HelloAck {
+    /// The device's [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION); the host stops on mismatch.
+    pub protocol_version: u16,
+    /// The session number of the [`Hello`] answered.
+    pub session: u32,
+    /// Firmware version.
+    pub firmware: FirmwareVersion,
+    /// Device identifier (MCU unique ID, zero-padded).
+    pub device_id: [u8; DEVICE_ID_LEN],
+    /// What the device can do.
+    pub capabilities: Capabilities,
+}
+
+impl HelloAck {
+    /// Payload length.
+    pub const LEN: usize = 2 + 4 + 3 + DEVICE_ID_LEN + 3 + 2 + 4;
+
+    pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
+        Ok(Self {
+            protocol_version: r.u16()?,
+            session: r.u32()?,
+            firmware: FirmwareVersion {
+                major: r.u8()?,
+                minor: r.u8()?,
+                patch: r.u8()?,
+            },
+            device_id: r.array()?,
+            capabilities: Capabilities {
+                chips: Chips(r.u8()?),
+                modes: Modes(r.u8()?),
+                buses: Buses(r.u8()?),
+                max_batch: r.u16()?,
+                buffer_capacity: r.u32()?,
+            },
+        })
+    }
+
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u16(self.protocol_version)?;
+        w.u32(self.session)?;
+        w.bytes(&[
+            self.firmware.major,
+            self.firmware.minor,
+            self.firmware.patch,
+        ])?;
+        w.bytes(&self.device_id)?;
+        let c = &self.capabilities;
+        w.bytes(&[c.chips.0, c.modes.0, c.buses.0])?;
+        w.u16(c.max_batch)?;
+        w.u32(c.buffer_capacity)
+    }
+}
+
+/// Host → device: start serving. The device sets its scene clock to `t0_ns` now and serves
+/// sample `i` at scene time [`Rate::sample_time_ns`](super::Rate::sample_time_ns)`(i)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Start {
+    /// Scene time at the instant the device receives this message, ns.
+    pub t0_ns: u64,
+}
+
+impl Start {
+    /// Payload length.
+    pub const LEN: usize = 8;
+
+    pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
+        Ok(Self { t0_ns: r.u64()? })
+    }
+
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u64(self.t0_ns)
+    }
+}
+
+code_enum! {
+    /// Why the device (re)booted.
+    pub enum ResetCause {
+        /// Not known.
+        Unknown = 0,
+        /// Power-on.
+        PowerOn = 1,
+        /// Software request.
+        Software = 2,
+        /// Watchdog.
+        Watchdog = 3,
+        /// Reset pin.
+        Pin = 4,
+        /// Brown-out.
+        Brownout = 5,
+    }
+}
+
+/// Device → host: sent once after boot, so the host detects a device reset mid-session.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Reset {
+    /// Why it booted.
+    pub cause: ResetCause,
+}
+
+impl Reset {
+    /// Payload length.
+    pub const LEN: usize = 1;
+
+    pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
+        Ok(Self {
+            cause: ResetCause::read(r)?,
+        })
+    }
+
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u8(self.cause as u8)
+    }
+}
+
+code_enum! {
+    /// What the device refused.
+    pub enum ErrorCode {
+        /// [`Hello`] with a protocol version the device does not speak.
+        UnsupportedVersion = 1,
+        /// A frame of a kind the device does not know (or that travels the other way).
+        UnknownMessage = 2,
+        /// A well-framed message whose payload did not parse.
+        MalformedMessage = 3,
+        /// [`Configure`](super::Configure) names a chip the device cannot emulate.
+        UnsupportedChip = 4,
+        /// [`Configure`](super::Configure) asks for a source the device does not support.
+        UnsupportedMode = 5,
+        /// The configuration was refused (the model rejected a term; `detail` may say which).
+        InvalidConfig = 6,
+        /// [`Start`] or samples before a valid [`Configure`](super::Configure).
+        NotConfigured = 7,
+        /// Samples beyond the credit limit (they were dropped and counted as overruns).
+        CreditExceeded = 8,
+        /// Anything else.
+        Internal = 9,
+    }
+}
+
+/// Device → host: a refusal, tied to the frame that caused it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ErrorReport {
+    /// What was refused.
+    pub code: ErrorCode,
+    /// Sequence number of the host frame that caused it.
+    pub seq: u16,
+    /// Code-specific detail (e.g. the offending kind byte or sample index, truncated).
+    pub detail: u32,
+}
+
+impl ErrorReport {
+    /// Payload length.
+    pub const LEN: usize = 7;
+
+    pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
+        Ok(Self {
+            code: ErrorCode::read(r)?,
+            seq: r.u16()?,
+            detail: r.u32()?,
+        })
+    }
+
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u8(self.code as u8)?;
+        w.u16(self.seq)?;
+        w.u32(self.detail)
+    }
+}
