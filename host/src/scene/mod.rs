@@ -58,7 +58,7 @@ impl Scene {
         let spec: SceneSpec =
             toml::from_str(text).map_err(|e| SceneError::from_toml(path, text, &e))?;
         let checked =
-            validate::check(&spec, path).map_err(|v| SceneError::from_violation(path, text, v))?;
+            validate::check(&spec).map_err(|v| SceneError::from_violation(path, text, v))?;
         Ok(Self {
             spec,
             path: path.to_path_buf(),

@@ -4,7 +4,6 @@
 use super::error::Violation;
 use super::schema::*;
 use margemu_model::time::{nanos_from_seconds, Nanos, SampleClock};
-use std::path::Path;
 
 /// What validation derives on the way.
 pub(crate) struct Checked {
@@ -15,7 +14,7 @@ pub(crate) struct Checked {
 
 type Check = Result<(), Violation>;
 
-pub(crate) fn check(spec: &SceneSpec, _path: &Path) -> Result<Checked, Violation> {
+pub(crate) fn check(spec: &SceneSpec) -> Result<Checked, Violation> {
     let duration_ns = positive_nanos(spec.duration, &["duration"])?;
     finite_positive(spec.rate, &["rate"])?;
     let clock = SampleClock::from_hz(spec.rate)
