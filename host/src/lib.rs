@@ -11,7 +11,8 @@
 //! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
-//! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`.
+//! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
+//! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs.
 #![warn(missing_docs)]
 
 pub mod analysis;
@@ -25,4 +26,5 @@ pub mod perf;
 pub mod reference;
 pub mod run;
 pub mod scene;
+pub mod stream;
 pub mod truth;

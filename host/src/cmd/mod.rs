@@ -2,8 +2,10 @@
 
 pub mod analyze;
 pub mod bench;
+pub mod ports;
 pub mod scene;
 pub mod simulate;
+pub mod stream;
 
 /// Every subcommand.
 #[derive(clap::Subcommand)]
@@ -19,6 +21,10 @@ pub enum Command {
     /// Measure speed against error on this machine.
     #[command(subcommand)]
     Bench(bench::Cmd),
+    /// Stream a scene to a device in real time over a serial port and log the session.
+    Stream(stream::Cmd),
+    /// List serial ports.
+    Ports(ports::Cmd),
 }
 
 impl Command {
@@ -28,6 +34,8 @@ impl Command {
             Command::Simulate(c) => c.run(),
             Command::Bench(c) => c.run(),
             Command::Analyze(c) => c.run(),
+            Command::Stream(c) => c.run(),
+            Command::Ports(c) => c.run(),
         }
     }
 }

@@ -1,0 +1,128 @@
+//! `margemu stream SCENE --port PATH [--baud N] [-o DIR]`: stream a scene to a device in real
+//! time and write the session directory.
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use margemu::scene::Scene;
+use margemu::stream::{open_port, Progress, Session, StreamConfig};
+use std::path::PathBuf;
+use std::time::Duration;
+
+#[derive(clap::Args)]
+pub struct Cmd {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// The device's serial port (e.g. /dev/ttyACM0, or a PTY path).
+    #[arg(long)]
+    port: String,
+    /// Line rate (ignored by USB CDC and pseudo-terminals).
+    #[arg(long, default_value_t = 921_600)]
+    baud: u32,
+    /// Session directory (default: sessions/<scene name>).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Write each batch this many milliseconds before its first sample's instant.
+    #[arg(long, default_value_t = 20.0)]
+    lead_ms: f64,
+    /// Most register images per batch.
+    #[arg(long, default_value_t = 32)]
+    batch: usize,
+    /// µT per unit of the scene's field (default: 1 for µT scenes, 50 for normalized ones).
+    #[arg(long)]
+    mag_ut_per_unit: Option<f64>,
+}
+
+impl Cmd {
+    pub fn run(self) -> Result<()> {
+        let scene = Scene::load(&self.scene)?;
+        let dir = self.output.clone().unwrap_or_else(|| {
+            let stem = self.scene.file_stem().unwrap_or_default();
+            PathBuf::from("sessions").join(stem)
+        });
+        let mut images = margemu::stream::ImageSettings::for_scene(&scene);
+        if let Some(v) = self.mag_ut_per_unit {
+            anyhow::ensure!(v.is_finite() && v > 0.0, "--mag-ut-per-unit must be > 0");
+            images.mag_ut_per_unit = v;
+        }
+        anyhow::ensure!(
+            self.lead_ms.is_finite() && self.lead_ms >= 0.0,
+            "--lead-ms must be ≥ 0"
+        );
+        let config = StreamConfig {
+            port: self.port.clone(),
+            baud: self.baud,
+            images: Some(images),
+            lead: Duration::from_secs_f64(self.lead_ms / 1000.0),
+            batch: self.batch.max(1),
+            ..StreamConfig::default()
+        };
+        let port =
+            open_port(&self.port, self.baud).with_context(|| format!("opening {}", self.port))?;
+        let session = Session::new(&scene, config, &dir)
+            .with_context(|| format!("preparing the session in {}", dir.display()))?;
+        eprintln!("image settings: {:?}", session.image_settings());
+        let stop = session.stop_flag();
+        ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
+            .context("installing the Ctrl-C handler")?;
+        let bar = ProgressBar::new(scene.samples());
+        bar.set_style(
+            ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}")
+                .expect("valid template"),
+        );
+        let summary = session
+            .run_on_port(port, |p| show(&bar, p))
+            .with_context(|| {
+                format!(
+                    "streaming {} to {} (logs in {})",
+                    scene.path.display(),
+                    self.port,
+                    dir.display()
+                )
+            });
+        bar.finish_and_clear();
+        let summary = summary?;
+        let t = summary.telemetry;
+        println!(
+            "sent {}/{} samples in {:.2} s to {}; served {}, underruns {}, overruns {}, device CRC errors {}, host receive errors {}",
+            summary.sent,
+            summary.samples,
+            summary.elapsed.as_secs_f64(),
+            self.port,
+            t.map_or(0, |t| t.samples_served),
+            t.map_or(0, |t| t.underruns),
+            t.map_or(0, |t| t.overruns),
+            t.map_or(0, |t| t.crc_errors),
+            summary.host_rx.crc_errors + summary.host_rx.framing_errors,
+        );
+        let j = summary.jitter;
+        println!(
+            "pacing jitter over {} batches: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; logs in {}",
+            j.batches,
+            j.p50_ns as f64 / 1e3,
+            j.p99_ns as f64 / 1e3,
+            j.max_ns as f64 / 1e3,
+            summary.dir.display()
+        );
+        Ok(())
+    }
+}
+
+fn show(bar: &ProgressBar, p: &Progress) {
+    bar.set_position(p.sent);
+    let secs = p.elapsed.as_secs_f64();
+    let t = p.telemetry;
+    let served = t.map_or(0, |t| t.samples_served);
+    let rate = if secs > 0.0 {
+        served as f64 / secs
+    } else {
+        0.0
+    };
+    bar.set_message(format!(
+        "| {rate:.0} samples/s served | underruns {} | CRC errors dev {} host {} | jitter {:.0} µs (max {:.0})",
+        t.map_or(0, |t| t.underruns),
+        t.map_or(0, |t| t.crc_errors),
+        p.host_rx.crc_errors,
+        p.last_late_ns as f64 / 1e3,
+        p.max_late_ns as f64 / 1e3,
+    ));
+}

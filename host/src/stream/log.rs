@@ -1,0 +1,186 @@
+//! The session directory: one folder per run, CSV files with a header row, flushed after every
+//! batch and every device message, so an interrupted run (Ctrl-C, a vanished device) leaves every
+//! row written so far readable.
+//!
+//! Host times (`host_ns`, `send_ns`) are nanoseconds on the host's monotonic clock since the
+//! session opened the port; `meta.toml`'s `start_host_ns` says when Start was sent, which is scene
+//! time 0. Device times are the device's scene time (ns). Columns:
+//!
+//! | file | columns |
+//! |---|---|
+//! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample of the scene |
+//! | `sent.csv` | `index,t_ns,send_ns,late_ns,image`: sample index, its latch instant, when its batch was written to the port, how late that write was against its schedule `start_host_ns + t_ns − lead` for the batch's first sample (empty for the prefill, written before Start), and the 22-byte register image as 44 lowercase hex digits |
+//! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
+//! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
+//! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before`: each write of the device under test (`bus` spi, i2c or aux; `dropped_before`: writes the device lost just before this batch) |
+//! | `events.csv` | `host_ns,event,detail`: handshake, credit stalls, device errors and resets, host receive errors, and how the session ended |
+
+use crate::output::TruthWriter;
+use crate::truth::Truth;
+use margemu_protocol::link::{Bus, Image, RegisterWrite, Telemetry};
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use super::images::image_hex;
+
+/// Header of `sent.csv`.
+pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image";
+/// Header of `device.csv`.
+pub const DEVICE_COLUMNS: &str =
+    "host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns";
+/// Header of `telemetry.csv`.
+pub const TELEMETRY_COLUMNS: &str = "host_ns,seq,time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns";
+/// Header of `register_writes.csv`.
+pub const REGISTER_WRITES_COLUMNS: &str =
+    "host_ns,time_ns,bus,address,register,value,dropped_before";
+/// Header of `events.csv`.
+pub const EVENTS_COLUMNS: &str = "host_ns,event,detail";
+
+/// The open CSV files of one session.
+pub struct SessionLog {
+    dir: PathBuf,
+    sent: BufWriter<File>,
+    device: BufWriter<File>,
+    telemetry: BufWriter<File>,
+    register_writes: BufWriter<File>,
+    events: BufWriter<File>,
+}
+
+fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
+    let mut out = BufWriter::with_capacity(1 << 16, File::create(dir.join(name))?);
+    writeln!(out, "{header}")?;
+    Ok(out)
+}
+
+impl SessionLog {
+    /// Creates `dir` and every file but `truth.csv`, with their headers, and writes `meta.toml`.
+    pub fn create(dir: &Path, meta: &str) -> io::Result<Self> {
+        std::fs::create_dir_all(dir)?;
+        std::fs::write(dir.join("meta.toml"), meta)?;
+        let mut log = Self {
+            dir: dir.to_path_buf(),
+            sent: create(dir, "sent.csv", SENT_COLUMNS)?,
+            device: create(dir, "device.csv", DEVICE_COLUMNS)?,
+            telemetry: create(dir, "telemetry.csv", TELEMETRY_COLUMNS)?,
+            register_writes: create(dir, "register_writes.csv", REGISTER_WRITES_COLUMNS)?,
+            events: create(dir, "events.csv", EVENTS_COLUMNS)?,
+        };
+        log.flush()?;
+        Ok(log)
+    }
+
+    /// The session directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Writes `truth.csv` in one go.
+    pub fn write_truth<'a>(&self, truths: impl Iterator<Item = &'a Truth>) -> io::Result<()> {
+        let file = BufWriter::with_capacity(1 << 20, File::create(self.dir.join("truth.csv"))?);
+        let mut out = TruthWriter::new(file)?;
+        for t in truths {
+            out.write(t)?;
+        }
+        out.finish()?.flush()
+    }
+
+    /// One row of `sent.csv`.
+    pub fn sent(
+        &mut self,
+        index: u64,
+        t_ns: u64,
+        send_ns: i64,
+        late_ns: Option<i64>,
+        image: &Image,
+    ) -> io::Result<()> {
+        let late = late_ns.map_or(String::new(), |v| v.to_string());
+        writeln!(
+            self.sent,
+            "{index},{t_ns},{send_ns},{late},{}",
+            image_hex(image)
+        )
+    }
+
+    /// A Telemetry: one row of `telemetry.csv` and, once samples were served, of `device.csv`
+    /// (`t_ns` is the host's latch instant of the last served index).
+    pub fn telemetry(
+        &mut self,
+        host_ns: i64,
+        seq: u16,
+        t: &Telemetry,
+        t_ns: Option<u64>,
+    ) -> io::Result<()> {
+        writeln!(
+            self.telemetry,
+            "{host_ns},{seq},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            t.time_ns,
+            t.state as u8,
+            t.samples_served,
+            t.underruns,
+            t.overruns,
+            t.crc_errors,
+            t.framing_errors,
+            t.lost_frames,
+            t.rejected_messages,
+            t.buffer_level,
+            t.next_index,
+            t.credit_limit,
+            t.last_served_index,
+            t.last_served_time_ns
+        )?;
+        if t.samples_served > 0 {
+            let t_ns = t_ns.map_or(String::new(), |v| v.to_string());
+            writeln!(
+                self.device,
+                "{host_ns},{},{},{},{},{t_ns},{}",
+                t.time_ns,
+                t.samples_served,
+                t.last_served_index,
+                t.last_served_time_ns,
+                t.underruns
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Rows of `register_writes.csv`.
+    pub fn register_writes(
+        &mut self,
+        host_ns: i64,
+        dropped: u32,
+        writes: &[RegisterWrite],
+    ) -> io::Result<()> {
+        for w in writes {
+            let bus = match w.bus {
+                Bus::Spi => "spi",
+                Bus::I2c => "i2c",
+                Bus::AuxMaster => "aux",
+            };
+            writeln!(
+                self.register_writes,
+                "{host_ns},{},{bus},{},{},{},{dropped}",
+                w.time_ns, w.address, w.register, w.value
+            )?;
+        }
+        Ok(())
+    }
+
+    /// One row of `events.csv` (commas in `detail` become semicolons).
+    pub fn event(&mut self, host_ns: i64, event: &str, detail: &str) -> io::Result<()> {
+        writeln!(
+            self.events,
+            "{host_ns},{event},{}",
+            detail.replace([',', '\n'], ";")
+        )
+    }
+
+    /// Flushes every file to the operating system.
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.sent.flush()?;
+        self.device.flush()?;
+        self.telemetry.flush()?;
+        self.register_writes.flush()?;
+        self.events.flush()
+    }
+}

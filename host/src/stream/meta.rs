@@ -1,0 +1,101 @@
+//! `meta.toml` of a session: what produced it (versions, scene, seed, port, rates, the register
+//! settings of the images) and, appended after the handshake, the device's `[device]` table.
+
+use super::images::ImageSettings;
+use super::session::{StreamConfig, WHO_AM_I};
+use crate::scene::Scene;
+use margemu_protocol::link::{HelloAck, Rate};
+use margemu_protocol::PROTOCOL_VERSION;
+use serde::Serialize;
+
+#[derive(Serialize)]
+struct Meta<'a> {
+    margemu_version: &'a str,
+    protocol_version: u16,
+    scene_file: String,
+    scene_sha256: String,
+    seed: u64,
+    samples: u64,
+    duration_s: f64,
+    rate_hz: f64,
+    rate_num: u32,
+    rate_den: u32,
+    port: &'a str,
+    baud: u32,
+    who_am_i: u8,
+    source: &'a str,
+    lead_ns: u64,
+    batch: usize,
+    telemetry_period_ns: u64,
+    session_id: u32,
+    field_unit: &'a str,
+    mag_ut_per_unit: f64,
+    default_temp_c: f32,
+    image: ImageMeta,
+    scene_text: &'a str,
+}
+
+#[derive(Serialize)]
+struct ImageMeta {
+    accel_fs: String,
+    gyro_fs: String,
+    mag_bits: String,
+    asa: [u8; 3],
+    gyro_offset: [i16; 3],
+    accel_offset: [i16; 3],
+}
+
+pub(super) fn metadata(scene: &Scene, c: &StreamConfig, s: &ImageSettings, rate: Rate) -> String {
+    let i = &s.image;
+    let meta = Meta {
+        margemu_version: env!("CARGO_PKG_VERSION"),
+        protocol_version: PROTOCOL_VERSION,
+        scene_file: scene.path.display().to_string(),
+        scene_sha256: scene.hash(),
+        seed: scene.spec.seed,
+        samples: scene.samples(),
+        duration_s: scene.spec.duration,
+        rate_hz: scene.clock.hz(),
+        rate_num: rate.num(),
+        rate_den: rate.den(),
+        port: &c.port,
+        baud: c.baud,
+        who_am_i: WHO_AM_I,
+        source: "images",
+        lead_ns: c.lead.as_nanos() as u64,
+        batch: c.batch,
+        telemetry_period_ns: c.telemetry_period.as_nanos() as u64,
+        session_id: c.session_id,
+        field_unit: scene.spec.field.unit.symbol(),
+        mag_ut_per_unit: s.mag_ut_per_unit,
+        default_temp_c: s.default_temp_c,
+        image: ImageMeta {
+            accel_fs: format!("{:?}", i.accel_fs),
+            gyro_fs: format!("{:?}", i.gyro_fs),
+            mag_bits: format!("{:?}", i.mag_bits),
+            asa: i.asa,
+            gyro_offset: i.gyro_offset,
+            accel_offset: i.accel_offset,
+        },
+        scene_text: &scene.text,
+    };
+    toml::to_string(&meta).expect("metadata serializes")
+}
+
+/// The `[device]` table appended to `meta.toml` after HelloAck.
+pub(super) fn device_meta(a: &HelloAck) -> String {
+    let c = a.capabilities;
+    let id: String = a.device_id.iter().map(|b| format!("{b:02x}")).collect();
+    format!(
+        "\n[device]\nprotocol_version = {}\nfirmware = \"{}.{}.{}\"\ndevice_id = \"{id}\"\nchips = {}\nmodes = {}\nbuses = {}\nmax_batch = {}\nbuffer_capacity = {}\n",
+        a.protocol_version,
+        a.firmware.major,
+        a.firmware.minor,
+        a.firmware.patch,
+        c.chips.0,
+        c.modes.0,
+        c.buses.0,
+        c.max_batch,
+        c.buffer_capacity
+    )
+}

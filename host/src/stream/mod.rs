@@ -1,0 +1,212 @@
+//! Real-time streaming of a scene to a device over a serial port (issue 5, source mode (a):
+//! register images).
+//!
+//! A [`Session`] predicts every register image of a validated [`Scene`](crate::scene::Scene)
+//! ([`predict`]: truth → [`MargSim`](crate::marg::MargSim) → [`ImageRepr::from_physical`] with an
+//! explicit [`ImageSettings`]), then speaks the link protocol of `docs/spec/link.md` over any
+//! byte port:
+//!
+//! 1. Hello → HelloAck: the protocol version must match, and the device must emulate the
+//!    MPU-9250 and take register images;
+//! 2. Configure (WHO_AM_I 0x71, the scene's exact rate, source "images") → the first Credit;
+//! 3. prefill (the samples due within the lead, as far as the window allows), then Start
+//!    (`t0_ns` = 0), which sets scene time 0 on the host's monotonic clock;
+//! 4. batches paced in real time: the batch that starts at sample `k` is written at
+//!    `start + t_k − lead`, never beyond the device's credit window; the time of every write and
+//!    how late it was against that schedule are logged (pacing jitter);
+//! 5. after the last sample's instant: wait for Telemetry saying it was served, Stop, and wait for
+//!    Telemetry in the stopped state.
+//!
+//! A receive thread ([`rx`]) decodes Credit, Telemetry, RegisterWrites, Reset and Error frames
+//! concurrently and counts damaged frames. The session stops with a [`StreamError`] on a device
+//! Reset after the handshake, a fatal device Error, end of file or an error on the port, a
+//! timeout waiting for HelloAck or credit, or the stop flag (Ctrl-C); in every case the logs
+//! ([`log`]) are flushed and end with an `end` row in `events.csv`.
+//!
+//! [`ImageRepr::from_physical`]: margemu_protocol::regmap::image::ImageRepr::from_physical
+
+pub mod images;
+pub mod log;
+mod meta;
+pub mod rx;
+mod session;
+
+pub use images::{image_hex, parse_image_hex, predict, ImageSettings, PredictedSample};
+pub use session::{rate_of, Session, StreamConfig, WHO_AM_I};
+
+use margemu_protocol::link::{HelloAck, RxStats, Telemetry};
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// Why a session stopped early.
+#[derive(Debug, thiserror::Error, docsplay::Display)]
+pub enum StreamError {
+    /// cannot predict the scene's samples
+    Predict(#[from] crate::run::RunError),
+    /// cannot write the session log in {path}
+    Log {
+        /// The session directory.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// cannot use the serial port
+    Port {
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// the scene's rate ({hz} Hz) is not an exact ratio of 32-bit integers the link can carry
+    Rate {
+        /// The scene's rate.
+        hz: f64,
+    },
+    /// no HelloAck within {timeout:?}: is a margemu device on this port, and is it running?
+    HelloTimeout {
+        /// How long the session waited.
+        timeout: Duration,
+    },
+    /// the device speaks link protocol {device}, this host {host}
+    VersionMismatch {
+        /// The device's version.
+        device: u16,
+        /// Ours.
+        host: u16,
+    },
+    /// the device cannot serve this session: {reason}
+    Unsupported {
+        /// What is missing.
+        reason: &'static str,
+    },
+    /// no credit for sample {index} within {timeout:?}: the device stopped granting its window
+    CreditTimeout {
+        /// The next sample to send.
+        index: u64,
+        /// How long the session waited.
+        timeout: Duration,
+    },
+    /// the device reset mid-session (cause: {cause})
+    DeviceReset {
+        /// The reset cause it reported.
+        cause: String,
+    },
+    /// the device refused the session: {detail}
+    DeviceRefused {
+        /// Its error report.
+        detail: String,
+    },
+    /// the device disconnected: {detail}
+    Disconnected {
+        /// What the port said.
+        detail: String,
+    },
+    /// interrupted; the device was asked to stop and the logs are complete up to here
+    Interrupted,
+}
+
+/// What a running session reports to its progress callback.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Samples written to the port.
+    pub sent: u64,
+    /// Samples in the scene.
+    pub total: u64,
+    /// Time since Start.
+    pub elapsed: Duration,
+    /// The device's latest Telemetry (served samples, underruns, its receive errors).
+    pub telemetry: Option<Telemetry>,
+    /// What the host's receiver counted (damaged and lost device frames).
+    pub host_rx: RxStats,
+    /// How late the last batch was written against its schedule, ns.
+    pub last_late_ns: i64,
+    /// The latest batch so far, ns.
+    pub max_late_ns: i64,
+}
+
+/// Pacing jitter: how late each batch was written against its schedule, over the batches
+/// written after Start that did not wait for credit (those count as credit stalls).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct JitterStats {
+    /// Batches measured.
+    pub batches: u64,
+    /// Median, ns.
+    pub p50_ns: i64,
+    /// 99th percentile, ns.
+    pub p99_ns: i64,
+    /// Largest, ns.
+    pub max_ns: i64,
+}
+
+impl JitterStats {
+    /// Nearest-rank percentiles of `late` (ns).
+    pub fn from_lateness(late: &[i64]) -> Self {
+        let mut v = late.to_vec();
+        v.sort_unstable();
+        let rank = |p: f64| -> i64 {
+            if v.is_empty() {
+                return 0;
+            }
+            let i = ((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
+            v[i]
+        };
+        Self {
+            batches: v.len() as u64,
+            p50_ns: rank(0.5),
+            p99_ns: rank(0.99),
+            max_ns: v.last().copied().unwrap_or(0),
+        }
+    }
+}
+
+/// How a completed session went.
+#[derive(Clone, Debug)]
+pub struct Summary {
+    /// Samples in the scene.
+    pub samples: u64,
+    /// Samples written to the port.
+    pub sent: u64,
+    /// The session directory.
+    pub dir: PathBuf,
+    /// When Start was written, ns since the port was opened (scene time 0).
+    pub start_host_ns: Option<i64>,
+    /// Pacing jitter.
+    pub jitter: JitterStats,
+    /// The device's last Telemetry.
+    pub telemetry: Option<Telemetry>,
+    /// The device's HelloAck.
+    pub device: Option<HelloAck>,
+    /// The host receiver's counters.
+    pub host_rx: RxStats,
+    /// Times a due batch had to wait for credit.
+    pub credit_stalls: u64,
+    /// The register settings of the images.
+    pub image_settings: ImageSettings,
+    /// Time from Start to the end.
+    pub elapsed: Duration,
+}
+
+/// Opens a serial port for a session (no exclusive lock, 50 ms read timeout).
+pub fn open_port(path: &str, baud: u32) -> Result<serialport::TTYPort, StreamError> {
+    let port = serialport::new(path, baud)
+        .timeout(Duration::from_millis(50))
+        .open_native()
+        .map_err(|e| StreamError::Port { source: e.into() })?;
+    Ok(port)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jitter_percentiles_by_nearest_rank() {
+        let late: Vec<i64> = (1..=100).collect();
+        let j = JitterStats::from_lateness(&late);
+        assert_eq!(
+            (j.batches, j.p50_ns, j.p99_ns, j.max_ns),
+            (100, 50, 99, 100)
+        );
+        assert_eq!(JitterStats::from_lateness(&[]), JitterStats::default());
+    }
+}
