@@ -5,10 +5,14 @@
 //! - [`chip`]: the emulated MARG chips behind the [`chip::SpiTarget`] and [`chip::I2cTarget`]
 //!   bus-target traits that a board's peripheral interrupts (or the host's embedded-hal
 //!   adapters) drive byte by byte.
+//! - [`link`]: the device side of the host link: frames in through the shared accumulator,
+//!   samples (register images, or kinematics through the shared model) swapped into the chip at
+//!   each sample instant, credits, telemetry and register writes out.
 #![no_std]
 #![warn(missing_docs)]
 
 pub mod chip;
+pub mod link;
 
 pub use margemu_model as model;
 pub use margemu_protocol as protocol;

@@ -41,6 +41,8 @@ pub const MAX_IMAGES_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 8) / IMAGE_LEN;
 pub const MAX_KINEMATICS_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 8) / TRUTH_LEN;
 /// Most entries in one [`RegisterWriteBatch`].
 pub const MAX_REGISTER_WRITES_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 4) / RegisterWrite::LEN;
+/// Most entries in one [`ServedBatch`].
+pub const MAX_SERVED_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 16) / ServedSample::LEN;
 
 /// A fixed-size item of a batch.
 pub trait WireItem: Sized + Copy {
@@ -152,6 +154,58 @@ impl WireItem for RegisterWrite {
     fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
         w.u64(self.time_ns)?;
         w.bytes(&[self.bus as u8, self.address, self.register, self.value])
+    }
+}
+
+/// Flags of a [`ServedSample`]: the instant was an underrun (the previous image held).
+const SERVED_UNDERRUN: u8 = 0x01;
+/// Flags of a [`ServedSample`]: no image had been received yet (nothing latched).
+const SERVED_EMPTY: u8 = 0x02;
+
+/// What the device served at one sample instant, for the host to check byte for byte.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ServedSample {
+    /// CRC-32C ([`CRC32C`](crate::link::CRC32C)) of the 22-byte image latched into the chip
+    /// (0 when `empty`).
+    pub crc32c: u32,
+    /// The sample was missing (an underrun): the previous image was latched again.
+    pub underrun: bool,
+    /// No image existed yet: nothing was latched.
+    pub empty: bool,
+}
+
+impl WireItem for ServedSample {
+    const LEN: usize = 5;
+    fn parse(bytes: &[u8]) -> Result<Self, Error> {
+        let mut r = Reader::new(bytes);
+        let crc32c = r.u32()?;
+        let flags = r.u8()?;
+        r.finish()?;
+        if flags & !(SERVED_UNDERRUN | SERVED_EMPTY) != 0
+            || (flags & SERVED_EMPTY != 0 && crc32c != 0)
+        {
+            return Err(Error::InvalidValue);
+        }
+        Ok(Self {
+            crc32c,
+            underrun: flags & SERVED_UNDERRUN != 0,
+            empty: flags & SERVED_EMPTY != 0,
+        })
+    }
+    fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        if self.empty && self.crc32c != 0 {
+            return Err(Error::InvalidValue);
+        }
+        w.u32(self.crc32c)?;
+        let mut flags = 0;
+        if self.underrun {
+            flags |= SERVED_UNDERRUN;
+        }
+        if self.empty {
+            flags |= SERVED_EMPTY;
+        }
+        w.u8(flags)
     }
 }
 
@@ -280,6 +334,49 @@ pub struct RegisterWriteBatch<'a> {
     pub writes: Items<'a, RegisterWrite>,
 }
 
+/// Device → host: what the device served at consecutive output sample instants.
+///
+/// Entry `k` is sample `first_index + k`, latched at scene time
+/// `rate.sample_time_ns(first_index + k)` (`first_time_ns` for the first entry).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ServedBatch<'a> {
+    /// Output sample index of the first entry.
+    pub first_index: u64,
+    /// Device scene time of the first entry, ns.
+    pub first_time_ns: u64,
+    /// The entries, at most [`MAX_SERVED_PER_BATCH`].
+    pub samples: Items<'a, ServedSample>,
+}
+
+impl<'a> ServedBatch<'a> {
+    /// A batch of `samples` starting at output index `first_index`, served at `first_time_ns`.
+    pub const fn new(first_index: u64, first_time_ns: u64, samples: &'a [ServedSample]) -> Self {
+        Self {
+            first_index,
+            first_time_ns,
+            samples: Items::from_slice(samples),
+        }
+    }
+    pub(crate) fn parse(r: &mut Reader<'a>) -> Result<Self, Error> {
+        let first_index = r.u64()?;
+        let first_time_ns = r.u64()?;
+        let samples = Items::parse(r)?;
+        Ok(Self {
+            first_index,
+            first_time_ns,
+            samples,
+        })
+    }
+    pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        w.u64(self.first_index)?;
+        w.u64(self.first_time_ns)?;
+        self.samples.emit(w)
+    }
+    pub(crate) fn buffer_len(&self) -> usize {
+        16 + self.samples.buffer_len()
+    }
+}
+
 impl<'a> ImageBatch<'a> {
     /// A batch of `images` starting at sample `first_index`.
     pub const fn new(first_index: u64, images: &'a [Image]) -> Self {
@@ -349,5 +446,58 @@ impl<'a> RegisterWriteBatch<'a> {
     }
     pub(crate) fn buffer_len(&self) -> usize {
         4 + self.writes.buffer_len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::link::Message;
+
+    #[test]
+    fn served_batch_round_trips_byte_for_byte() {
+        let samples = [
+            ServedSample {
+                crc32c: 0x0403_0201,
+                underrun: false,
+                empty: false,
+            },
+            ServedSample {
+                crc32c: 0xDDCC_BBAA,
+                underrun: true,
+                empty: false,
+            },
+            ServedSample {
+                crc32c: 0,
+                underrun: true,
+                empty: true,
+            },
+        ];
+        let msg = Message::Served(ServedBatch::new(0x10, 0x20, &samples));
+        let mut buf = [0u8; 64];
+        let n = msg.emit(&mut buf).unwrap();
+        assert_eq!(n, msg.buffer_len());
+        #[rustfmt::skip]
+        let expected = [
+            0x10, 0, 0, 0, 0, 0, 0, 0, // first_index
+            0x20, 0, 0, 0, 0, 0, 0, 0, // first_time_ns
+            0x01, 0x02, 0x03, 0x04, 0x00, // crc, flags
+            0xAA, 0xBB, 0xCC, 0xDD, 0x01,
+            0x00, 0x00, 0x00, 0x00, 0x03,
+        ];
+        assert_eq!(&buf[..n], &expected);
+        assert_eq!(Message::parse(0x87, &buf[..n]).unwrap(), msg);
+        // Reserved flag bits, a CRC with `empty`, and a partial entry are rejected.
+        let mut bad = expected;
+        bad[20] = 0x04;
+        assert_eq!(Message::parse(0x87, &bad), Err(Error::InvalidValue));
+        let mut bad = expected;
+        bad[26] = 1;
+        assert_eq!(Message::parse(0x87, &bad), Err(Error::InvalidValue));
+        assert_eq!(
+            Message::parse(0x87, &expected[..n - 1]),
+            Err(Error::PayloadTooLong)
+        );
+        assert_eq!(MAX_SERVED_PER_BATCH, 302);
     }
 }

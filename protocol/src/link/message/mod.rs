@@ -18,6 +18,7 @@
 //! | 0x84 | [`RegisterWriteBatch`] | device → host |
 //! | 0x85 | [`Reset`] | device → host |
 //! | 0x86 | [`ErrorReport`] | device → host |
+//! | 0x87 | [`ServedBatch`] | device → host |
 //!
 //! ```
 //! use margemu_protocol::link::{ImageBatch, Kind, Message, IMAGE_LEN};
@@ -40,9 +41,9 @@ mod session;
 mod status;
 
 pub use batch::{
-    Bus, Image, ImageBatch, Items, KinematicsBatch, RegisterWrite, RegisterWriteBatch, WireItem,
-    IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH, MAX_REGISTER_WRITES_PER_BATCH,
-    TRUTH_LEN,
+    Bus, Image, ImageBatch, Items, KinematicsBatch, RegisterWrite, RegisterWriteBatch, ServedBatch,
+    ServedSample, WireItem, IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH,
+    MAX_REGISTER_WRITES_PER_BATCH, MAX_SERVED_PER_BATCH, TRUTH_LEN,
 };
 pub use configure::{Configure, ModelParams, Rate, RegisterFile, RegisterOverride, Source};
 pub use configure::{MAX_CONFIGURE_LEN, MAX_OVERRIDES};
@@ -85,6 +86,8 @@ pub enum Kind {
     Reset = 0x85,
     /// [`ErrorReport`].
     Error = 0x86,
+    /// [`ServedBatch`].
+    Served = 0x87,
 }
 
 impl Kind {
@@ -103,6 +106,7 @@ impl Kind {
             0x84 => Self::RegisterWrites,
             0x85 => Self::Reset,
             0x86 => Self::Error,
+            0x87 => Self::Served,
             _ => return None,
         })
     }
@@ -144,6 +148,8 @@ pub enum Message<'a> {
     Reset(Reset),
     /// Device: it refused something.
     Error(ErrorReport),
+    /// Device: what it served at each sample instant.
+    Served(ServedBatch<'a>),
 }
 
 impl<'a> Message<'a> {
@@ -162,6 +168,7 @@ impl<'a> Message<'a> {
             Self::RegisterWrites(_) => Kind::RegisterWrites,
             Self::Reset(_) => Kind::Reset,
             Self::Error(_) => Kind::Error,
+            Self::Served(_) => Kind::Served,
         }
     }
 
@@ -187,6 +194,7 @@ impl<'a> Message<'a> {
             Kind::RegisterWrites => Self::RegisterWrites(RegisterWriteBatch::parse(&mut r)?),
             Kind::Reset => Self::Reset(Reset::parse(&mut r)?),
             Kind::Error => Self::Error(ErrorReport::parse(&mut r)?),
+            Kind::Served => Self::Served(ServedBatch::parse(&mut r)?),
         };
         r.finish()?;
         Ok(msg)
@@ -207,6 +215,7 @@ impl<'a> Message<'a> {
             Self::RegisterWrites(m) => m.buffer_len(),
             Self::Reset(_) => Reset::LEN,
             Self::Error(_) => ErrorReport::LEN,
+            Self::Served(m) => m.buffer_len(),
         }
     }
 
@@ -227,6 +236,7 @@ impl<'a> Message<'a> {
             Self::RegisterWrites(m) => m.emit(&mut w),
             Self::Reset(m) => m.emit(&mut w),
             Self::Error(m) => m.emit(&mut w),
+            Self::Served(m) => m.emit(&mut w),
         }?;
         Ok(w.position())
     }

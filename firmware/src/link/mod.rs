@@ -1,0 +1,713 @@
+//! The device side of the host link (`docs/spec/link.md` §6–7): frames in, the emulated chip's
+//! samples served on time, credits, telemetry and register writes out.
+//!
+//! A [`Device`] is driven by two calls, with time passed in as `now_ns` (the device's monotonic
+//! clock, any origin) so the same code runs under a board's UART interrupt and timer, in the
+//! host's loopback thread, and in tests with a hand-advanced clock:
+//! - [`Device::feed`]: received bytes, in any chunks, through the shared
+//!   [`Accumulator`]; handles Hello, Configure, Start, Stop and the sample batches, and counts
+//!   damaged frames ([`RxStats`]) and sequence gaps ([`SeqTracker`]);
+//! - [`Device::poll`]: serves every sample instant that is due, then sends what is pending
+//!   (HelloAck, Error, Served, Credit, RegisterWrites, Telemetry) through the `tx` callback,
+//!   one wire frame per call.
+//!
+//! **Refusals.** Each is answered with an Error frame and counted in `rejected_messages`:
+//! a Hello of another protocol version (1), a device → host or unknown kind (2, detail the kind
+//! byte), a payload that does not parse (3), an unknown WHO_AM_I (4), a perturbation or a batch
+//! of the other source (5), a model the shared `Marg` refuses or a Configure while running (6),
+//! Start or samples before Configure (7), a second Start while running (9). Samples beyond the
+//! credit limit are answered with Error 8 (detail: the first dropped index, truncated).
+//!
+//! **Register writes** of the device under test are drained from the chip's write log at every
+//! poll and stamped with the scene time of that poll (the log itself has no time stamps), so
+//! their resolution is one poll; `dropped` counts the entries the log overwrote in between.
+//! Configure's register overrides are applied through the chip's own bus targets (the AK8963's
+//! through I2C bypass, restored afterwards) and are not reported as writes.
+//!
+//! **Served reports.** Every instant served is reported in a [`ServedBatch`] (index, scene time,
+//! CRC-32C of the 22-byte image latched, underrun flag), sent once [`SERVED_FLUSH`] entries are
+//! waiting, with every Telemetry, and when serving stops, so the host can check byte for byte
+//! what the chip presented.
+//!
+//! **Time base.** Start { t0 } received at local time `s` sets the scene clock to
+//! `t0 + (now_ns − s)`. Output sample `k` is served when the scene clock reaches
+//! `rate.sample_time_ns(k) = floor(k·den·10⁹/num)`, the first being the smallest `k` with that
+//! instant `≥ t0`; the chip is latched at that scene time, so its registers, INT pulses and
+//! AK8963 schedule run on scene time. A late poll serves the missed instants in order (at most
+//! [`MAX_CATCH_UP`] per call).
+//!
+//! **Buffering.** Each sample swaps into the chip's data registers in one step (the chip defers
+//! it while a bus transaction is in progress, so a burst never mixes two samples); the ring
+//! ([`SampleRing`], `N` samples) holds what the host sent ahead. At an instant whose sample is
+//! missing the device counts an **underrun** and holds the last sample (mode (a): the last image
+//! is latched again; mode (b): the model steps on the last kinematics). Samples at or beyond
+//! the credit limit are dropped and counted as **overruns** (and answered with Error 8).
+//!
+//! **Source (b).** The host sends kinematics at `truth_rate`; at output instant `t` the device
+//! uses the latest kinematics sample `j` with `truth_rate.sample_time_ns(j) ≤ t` (sample and
+//! hold), steps the shared [`Marg`](margemu_model::sensor::Marg) (seeded from Configure, at the
+//! output rate) and converts with [`setup::model_image`]. The credit window counts kinematics
+//! indices. A magnetic perturbation is refused (Error 5, detail 1): its FFT buffers (tens to
+//! hundreds of KB) do not fit a generic no-alloc device.
+//!
+//! ```
+//! use margemu_firmware::link::Device;
+//! use margemu_protocol::link::{Encoder, Hello, Message, MAX_WIRE_LEN};
+//! use margemu_protocol::PROTOCOL_VERSION;
+//! let mut device = Device::<64>::new();
+//! let mut wire = [0u8; MAX_WIRE_LEN];
+//! let mut host = Encoder::new();
+//! let hello = Hello { protocol_version: PROTOCOL_VERSION, session: 7 };
+//! let n = host.encode(&Message::Hello(hello), &mut wire).unwrap();
+//! device.feed(&wire[..n], 0);
+//! let mut frames = 0;
+//! device.poll(0, &mut |_frame: &[u8]| frames += 1);
+//! assert_eq!(frames, 2); // Reset (after boot), HelloAck
+//! ```
+
+mod ring;
+pub mod setup;
+
+pub use ring::{Insert, SampleRing};
+
+use margemu_model::sensor::Truth;
+use margemu_protocol::link::{
+    Accumulator, Bus, Buses, Capabilities, Configure, Credit, DeviceState, Encoder, ErrorCode,
+    ErrorReport, FeedResult, FirmwareVersion, Frame, Hello, HelloAck, Image, Kind, Message, Modes,
+    Rate, RegisterWrite, RegisterWriteBatch, Reset, ResetCause, RxStats, SeqTracker, Source, Start,
+    Telemetry, DEVICE_ID_LEN, MAX_IMAGES_PER_BATCH, MAX_WIRE_LEN,
+};
+use margemu_protocol::link::{ServedBatch, ServedSample, CRC32C};
+use margemu_protocol::PROTOCOL_VERSION;
+
+use crate::chip::{self, Mpu9250};
+use setup::Model;
+
+/// Telemetry period when Configure asks for the default (0): 100 ms.
+pub const DEFAULT_TELEMETRY_PERIOD_NS: u64 = 100_000_000;
+
+/// Most sample instants one [`Device::poll`] serves (the rest wait for the next call).
+pub const MAX_CATCH_UP: u32 = 4096;
+
+/// Served entries that trigger a [`ServedBatch`] frame (also sent with every Telemetry).
+pub const SERVED_FLUSH: usize = 32;
+
+/// Served entries held between two frames.
+const SERVED_CAPACITY: usize = 64;
+
+/// Register writes per RegisterWrites frame.
+const WRITES_PER_FRAME: usize = 32;
+
+/// Error reports queued between two polls (more are dropped; the counters still count).
+const ERROR_QUEUE: usize = 4;
+
+/// One sample slot: a finished image (mode (a)) or a kinematics sample (mode (b)).
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    Image(Image),
+    Truth(Truth),
+}
+
+/// What the device has served, cumulative since boot or the last Hello (wrapping).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Sample instants passed while running (underruns included).
+    pub served: u64,
+    /// Instants with no sample (last one held).
+    pub underruns: u32,
+    /// Samples dropped at or beyond the credit limit.
+    pub overruns: u32,
+    /// Receive-side counters (damaged frames, lost frames, rejected messages).
+    pub rx: RxStats,
+}
+
+/// The last sample instant served.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Served {
+    /// Output sample index.
+    pub index: u64,
+    /// Scene time of its instant (the chip was latched at it), ns.
+    pub time_ns: u64,
+    /// The image latched (the held one after an underrun), `None` if none was available yet.
+    pub image: Option<Image>,
+    /// Whether this instant was an underrun.
+    pub underrun: bool,
+}
+
+/// Identity reported in HelloAck.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Identity {
+    /// Firmware version.
+    pub firmware: FirmwareVersion,
+    /// MCU unique ID, zero-padded.
+    pub device_id: [u8; DEVICE_ID_LEN],
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Session {
+    rate: Rate,
+    telemetry_period_ns: u64,
+    images: bool,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Clock {
+    start_local_ns: u64,
+    t0_ns: u64,
+    next_k: u64,
+}
+
+/// The link handler of one emulated chip, with a buffer of `N` samples (see the module docs).
+pub struct Device<const N: usize = 128> {
+    rx: Accumulator,
+    core: Core<N>,
+}
+
+struct Core<const N: usize> {
+    chip: Mpu9250,
+    identity: Identity,
+    state: DeviceState,
+    session: Option<Session>,
+    model: Option<Model>,
+    clock: Option<Clock>,
+    ring: SampleRing<Slot, N>,
+    counters: Counters,
+    seq: SeqTracker,
+    last_served: Option<Served>,
+    last_image: Option<Image>,
+    scene_now_ns: u64,
+    // Outgoing.
+    tx: Encoder,
+    wire: [u8; MAX_WIRE_LEN],
+    reset_pending: Option<ResetCause>,
+    hello_ack: Option<u32>,
+    errors: [Option<ErrorReport>; ERROR_QUEUE],
+    credit_pending: bool,
+    credit_sent_limit: u64,
+    telemetry_pending: bool,
+    next_telemetry_local_ns: u64,
+    writes_dropped_seen: u32,
+    served: [ServedSample; SERVED_CAPACITY],
+    served_len: usize,
+    served_first: (u64, u64),
+}
+
+impl<const N: usize> Default for Device<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> Device<N> {
+    /// A device just powered on: idle, an MPU-9250 at reset, a Reset (power-on) frame pending.
+    pub fn new() -> Self {
+        Self::with_identity(Identity::default(), ResetCause::PowerOn)
+    }
+
+    /// A device with its HelloAck identity, after a reset of `cause`.
+    pub fn with_identity(identity: Identity, cause: ResetCause) -> Self {
+        Self {
+            rx: Accumulator::new(),
+            core: Core {
+                chip: Mpu9250::new(),
+                identity,
+                state: DeviceState::Idle,
+                session: None,
+                model: None,
+                clock: None,
+                ring: SampleRing::new(),
+                counters: Counters::default(),
+                seq: SeqTracker::new(),
+                last_served: None,
+                last_image: None,
+                scene_now_ns: 0,
+                tx: Encoder::new(),
+                wire: [0; MAX_WIRE_LEN],
+                reset_pending: Some(cause),
+                hello_ack: None,
+                errors: [None; ERROR_QUEUE],
+                credit_pending: false,
+                credit_sent_limit: 0,
+                telemetry_pending: false,
+                next_telemetry_local_ns: 0,
+                writes_dropped_seen: 0,
+                served: [ServedSample::default(); SERVED_CAPACITY],
+                served_len: 0,
+                served_first: (0, 0),
+            },
+        }
+    }
+
+    /// Takes received bytes (any chunking) at local time `now_ns`.
+    pub fn feed(&mut self, mut rx: &[u8], now_ns: u64) {
+        while !rx.is_empty() {
+            let result = self.rx.feed(rx);
+            self.core.counters.rx.record(&result);
+            rx = result.remaining();
+            if let FeedResult::Success { frame, .. } = result {
+                self.core.handle(&frame, now_ns);
+            }
+        }
+    }
+
+    /// Serves the sample instants due at local time `now_ns`, then sends what is pending
+    /// through `tx` (one complete wire frame per call).
+    pub fn poll(&mut self, now_ns: u64, tx: &mut impl FnMut(&[u8])) {
+        self.core.poll(now_ns, tx);
+    }
+
+    /// The emulated chip, for the board's (or the host's) SPI/I2C target.
+    pub fn chip_mut(&mut self) -> &mut Mpu9250 {
+        &mut self.core.chip
+    }
+
+    /// The emulated chip.
+    pub fn chip(&self) -> &Mpu9250 {
+        &self.core.chip
+    }
+
+    /// The counters.
+    pub fn counters(&self) -> &Counters {
+        &self.core.counters
+    }
+
+    /// The session state.
+    pub fn state(&self) -> DeviceState {
+        self.core.state
+    }
+
+    /// The last sample instant served.
+    pub fn last_served(&self) -> Option<Served> {
+        self.core.last_served
+    }
+
+    /// The current credit window.
+    pub fn credit(&self) -> Credit {
+        self.core.credit()
+    }
+
+    /// Samples buffered now.
+    pub fn buffer_level(&self) -> usize {
+        self.core.ring.level()
+    }
+
+    /// The scene clock at local time `now_ns` (the last one seen when not running).
+    pub fn scene_time_ns(&self, now_ns: u64) -> u64 {
+        self.core.scene_time(now_ns)
+    }
+
+    /// What the device advertises in HelloAck.
+    pub fn capabilities() -> Capabilities {
+        Capabilities {
+            chips: setup::CHIPS,
+            modes: Modes::IMAGES | Modes::MODEL,
+            buses: Buses::SPI | Buses::I2C,
+            max_batch: MAX_IMAGES_PER_BATCH as u16,
+            buffer_capacity: u32::try_from(N).unwrap_or(u32::MAX),
+        }
+    }
+}
+
+impl<const N: usize> Core<N> {
+    fn refuse(&mut self, code: ErrorCode, seq: u16, detail: u32) {
+        self.counters.rx.rejected_messages = self.counters.rx.rejected_messages.wrapping_add(1);
+        self.error(code, seq, detail);
+    }
+
+    fn error(&mut self, code: ErrorCode, seq: u16, detail: u32) {
+        if let Some(slot) = self.errors.iter_mut().find(|e| e.is_none()) {
+            *slot = Some(ErrorReport { code, seq, detail });
+        }
+    }
+
+    fn handle(&mut self, frame: &Frame<&[u8]>, now_ns: u64) {
+        let (kind, seq) = (frame.kind(), frame.seq());
+        if kind == Kind::Hello as u8 {
+            self.seq.restart();
+        }
+        let event = self.seq.observe(seq);
+        self.counters.rx.record_seq(event);
+        let message = match Message::parse(kind, frame.payload()) {
+            Ok(m) => m,
+            Err(e) => {
+                self.counters.rx.record_error(e);
+                let code = match Kind::from_u8(kind) {
+                    None => ErrorCode::UnknownMessage,
+                    Some(_) => ErrorCode::MalformedMessage,
+                };
+                self.error(code, seq, u32::from(kind));
+                return;
+            }
+        };
+        match message {
+            Message::Hello(h) => self.hello(h, seq),
+            Message::Configure(c) => self.configure(&c, seq, now_ns),
+            Message::Start(s) => self.start(s, seq, now_ns),
+            Message::Stop => self.stop(now_ns),
+            Message::Images(b) => {
+                let samples = b.images.iter().map(Slot::Image);
+                self.samples(true, b.first_index, samples, seq);
+            }
+            Message::Kinematics(b) => {
+                let samples = b.samples.iter().map(Slot::Truth);
+                self.samples(false, b.first_index, samples, seq);
+            }
+            _ => self.refuse(ErrorCode::UnknownMessage, seq, u32::from(kind)),
+        }
+    }
+
+    fn hello(&mut self, h: Hello, seq: u16) {
+        if h.protocol_version != PROTOCOL_VERSION {
+            self.refuse(
+                ErrorCode::UnsupportedVersion,
+                seq,
+                u32::from(h.protocol_version),
+            );
+            return;
+        }
+        self.state = DeviceState::Idle;
+        self.session = None;
+        self.model = None;
+        self.clock = None;
+        self.ring.reset(0);
+        let rx = RxStats {
+            frames: 1,
+            ..RxStats::default()
+        };
+        self.counters = Counters {
+            rx,
+            ..Counters::default()
+        };
+        self.last_served = None;
+        self.last_image = None;
+        self.scene_now_ns = 0;
+        self.errors = [None; ERROR_QUEUE];
+        self.served_len = 0;
+        self.credit_pending = false;
+        self.telemetry_pending = false;
+        self.hello_ack = Some(h.session);
+    }
+
+    fn configure(&mut self, c: &Configure, seq: u16, now_ns: u64) {
+        if self.state == DeviceState::Running {
+            self.refuse(ErrorCode::InvalidConfig, seq, DeviceState::Running as u32);
+            return;
+        }
+        if !setup::source_supported(&c.source) {
+            self.refuse(ErrorCode::UnsupportedMode, seq, 1);
+            return;
+        }
+        let chip = match setup::build_chip(c) {
+            Ok(chip) => chip,
+            Err(code) => return self.refuse(code, seq, u32::from(c.who_am_i)),
+        };
+        let model = match &c.source {
+            Source::Images => None,
+            Source::Model(p) => match Model::new(p, c.rate) {
+                Some(m) => Some(m),
+                None => return self.refuse(ErrorCode::InvalidConfig, seq, 0),
+            },
+        };
+        let period = match c.telemetry_period_ns {
+            0 => DEFAULT_TELEMETRY_PERIOD_NS,
+            p => p,
+        };
+        self.session = Some(Session {
+            rate: c.rate,
+            telemetry_period_ns: period,
+            images: model.is_none(),
+        });
+        self.chip = chip;
+        self.model = model;
+        self.clock = None;
+        self.ring.reset(0);
+        self.last_image = None;
+        self.state = DeviceState::Configured;
+        self.credit_pending = true;
+        self.next_telemetry_local_ns = now_ns.saturating_add(period);
+    }
+
+    fn start(&mut self, s: Start, seq: u16, now_ns: u64) {
+        let Some(session) = self.session.filter(|_| self.state != DeviceState::Running) else {
+            let code = match self.state {
+                DeviceState::Running => ErrorCode::Internal,
+                _ => ErrorCode::NotConfigured,
+            };
+            return self.refuse(code, seq, self.state as u32);
+        };
+        let rate = session.rate;
+        // The first k with floor(k·den·1e9/num) ≥ t0: k = ceil(t0·num / (den·1e9)).
+        let den = u128::from(rate.den()) * 1_000_000_000;
+        let k0 = (u128::from(s.t0_ns) * u128::from(rate.num())).div_ceil(den);
+        self.clock = Some(Clock {
+            start_local_ns: now_ns,
+            t0_ns: s.t0_ns,
+            next_k: u64::try_from(k0).unwrap_or(u64::MAX),
+        });
+        self.scene_now_ns = s.t0_ns;
+        self.state = DeviceState::Running;
+    }
+
+    fn stop(&mut self, now_ns: u64) {
+        if self.state == DeviceState::Running {
+            self.scene_now_ns = self.scene_time(now_ns);
+            self.state = DeviceState::Stopped;
+        }
+        self.telemetry_pending = true;
+    }
+
+    fn samples(&mut self, images: bool, first: u64, samples: impl Iterator<Item = Slot>, seq: u16) {
+        let Some(session) = self.session.filter(|_| self.state != DeviceState::Idle) else {
+            return self.refuse(ErrorCode::NotConfigured, seq, first as u32);
+        };
+        if session.images != images {
+            return self.refuse(ErrorCode::UnsupportedMode, seq, u32::from(images));
+        }
+        let mut first_overrun = None;
+        for (i, slot) in (0u64..).zip(samples) {
+            // An index past u64::MAX is beyond any credit limit: an overrun too.
+            let index = first.saturating_add(i);
+            if self.ring.insert(index, slot) == Insert::Overrun {
+                self.counters.overruns = self.counters.overruns.wrapping_add(1);
+                first_overrun.get_or_insert(index);
+            }
+        }
+        if let Some(index) = first_overrun {
+            self.error(ErrorCode::CreditExceeded, seq, index as u32);
+        }
+    }
+
+    fn scene_time(&self, now_ns: u64) -> u64 {
+        match (self.state, self.clock) {
+            (DeviceState::Running, Some(c)) => c
+                .t0_ns
+                .saturating_add(now_ns.saturating_sub(c.start_local_ns)),
+            _ => self.scene_now_ns,
+        }
+    }
+
+    fn credit(&self) -> Credit {
+        Credit {
+            next_index: self.ring.next_index(),
+            limit: self.ring.limit(),
+        }
+    }
+
+    /// Serves every instant due by `now_ns` (at most [`MAX_CATCH_UP`]).
+    fn serve_due(&mut self, now_ns: u64, tx: &mut impl FnMut(&[u8])) {
+        if self.state != DeviceState::Running {
+            return;
+        }
+        let (Some(session), Some(mut clock)) = (self.session, self.clock) else {
+            return;
+        };
+        let now = self.scene_time(now_ns);
+        self.scene_now_ns = now;
+        for _ in 0..MAX_CATCH_UP {
+            let t = session.rate.sample_time_ns(clock.next_k);
+            if t > now || clock.next_k == u64::MAX {
+                break;
+            }
+            self.serve(clock.next_k, t);
+            self.log_served(tx);
+            clock.next_k += 1;
+        }
+        self.clock = Some(clock);
+        self.chip.advance(now);
+    }
+
+    fn serve(&mut self, k: u64, t: u64) {
+        let (image, underrun) = match self.model.as_mut() {
+            None => match self.ring.take(k) {
+                Some(Slot::Image(image)) => (Some(image), false),
+                _ => (self.last_image, true),
+            },
+            Some(model) => {
+                let j = model.truth_index_at(t);
+                self.ring.advance_to(j);
+                let fresh = match self.ring.get(j) {
+                    Some(Slot::Truth(truth)) => {
+                        model.hold(truth);
+                        true
+                    }
+                    _ => false,
+                };
+                (model.image(&self.chip), !fresh)
+            }
+        };
+        if let Some(image) = &image {
+            self.chip.latch_image_at(image, t);
+        }
+        self.last_image = image.or(self.last_image);
+        let c = &mut self.counters;
+        c.served = c.served.wrapping_add(1);
+        if underrun {
+            c.underruns = c.underruns.wrapping_add(1);
+        }
+        self.last_served = Some(Served {
+            index: k,
+            time_ns: t,
+            image,
+            underrun,
+        });
+    }
+
+    /// Appends the last instant served to the Served log (sending the log first when it is
+    /// full or the new index does not follow it).
+    fn log_served(&mut self, tx: &mut impl FnMut(&[u8])) {
+        let Some(s) = self.last_served else { return };
+        let (first, _) = self.served_first;
+        let follows = first.checked_add(self.served_len as u64) == Some(s.index);
+        if self.served_len == SERVED_CAPACITY || (self.served_len > 0 && !follows) {
+            self.flush_served(tx);
+        }
+        if self.served_len == 0 {
+            self.served_first = (s.index, s.time_ns);
+        }
+        if let Some(slot) = self.served.get_mut(self.served_len) {
+            *slot = ServedSample {
+                crc32c: s.image.map_or(0, |im| CRC32C.checksum(&im)),
+                underrun: s.underrun,
+                empty: s.image.is_none(),
+            };
+            self.served_len += 1;
+        }
+    }
+
+    fn flush_served(&mut self, tx: &mut impl FnMut(&[u8])) {
+        let n = core::mem::take(&mut self.served_len);
+        if n == 0 {
+            return;
+        }
+        let (first, time) = self.served_first;
+        let served = self.served;
+        let samples = served.get(..n).unwrap_or(&[]);
+        self.send(&Message::Served(ServedBatch::new(first, time, samples)), tx);
+    }
+
+    fn telemetry(&self) -> Telemetry {
+        let credit = self.credit();
+        let last = self.last_served;
+        Telemetry {
+            time_ns: self.scene_now_ns,
+            state: self.state,
+            samples_served: self.counters.served,
+            underruns: self.counters.underruns,
+            overruns: self.counters.overruns,
+            crc_errors: self.counters.rx.crc_errors,
+            framing_errors: self.counters.rx.framing_errors,
+            lost_frames: self.counters.rx.lost_frames,
+            rejected_messages: self.counters.rx.rejected_messages,
+            buffer_level: u32::try_from(self.ring.level()).unwrap_or(u32::MAX),
+            next_index: credit.next_index,
+            credit_limit: credit.limit,
+            last_served_index: last.map_or(0, |s| s.index),
+            last_served_time_ns: last.map_or(0, |s| s.time_ns),
+        }
+    }
+
+    fn send(&mut self, message: &Message<'_>, tx: &mut impl FnMut(&[u8])) {
+        if let Ok(n) = self.tx.encode(message, &mut self.wire) {
+            if let Some(bytes) = self.wire.get(..n) {
+                tx(bytes);
+            }
+        }
+    }
+
+    fn poll(&mut self, now_ns: u64, tx: &mut impl FnMut(&[u8])) {
+        if let Some(cause) = self.reset_pending.take() {
+            self.send(&Message::Reset(Reset { cause }), tx);
+        }
+        if let Some(session) = self.hello_ack.take() {
+            let ack = HelloAck {
+                protocol_version: PROTOCOL_VERSION,
+                session,
+                firmware: self.identity.firmware,
+                device_id: self.identity.device_id,
+                capabilities: Device::<N>::capabilities(),
+            };
+            self.send(&Message::HelloAck(ack), tx);
+        }
+        for i in 0..ERROR_QUEUE {
+            if let Some(e) = self.errors.get_mut(i).and_then(Option::take) {
+                self.send(&Message::Error(e), tx);
+            }
+        }
+        self.serve_due(now_ns, tx);
+        self.send_writes(tx);
+        let active = matches!(self.state, DeviceState::Configured | DeviceState::Running);
+        if active && now_ns >= self.next_telemetry_local_ns {
+            self.telemetry_pending = true;
+        }
+        let running = self.state == DeviceState::Running;
+        if self.served_len >= SERVED_FLUSH || self.telemetry_pending || !running {
+            self.flush_served(tx);
+        }
+        let quarter = (N as u64 / 4).max(1);
+        let advanced = self.ring.limit().saturating_sub(self.credit_sent_limit) >= quarter;
+        let configured = self.session.is_some() && self.state != DeviceState::Idle;
+        if configured && (self.credit_pending || self.telemetry_pending || advanced) {
+            self.credit_pending = false;
+            self.credit_sent_limit = self.ring.limit();
+            self.send(&Message::Credit(self.credit()), tx);
+        }
+        if self.telemetry_pending {
+            self.telemetry_pending = false;
+            let period = self
+                .session
+                .map_or(DEFAULT_TELEMETRY_PERIOD_NS, |s| s.telemetry_period_ns);
+            self.next_telemetry_local_ns = now_ns.saturating_add(period);
+            self.send(&Message::Telemetry(self.telemetry()), tx);
+        }
+    }
+
+    /// Drains the chip's write log into RegisterWrites frames, stamped with the scene time.
+    fn send_writes(&mut self, tx: &mut impl FnMut(&[u8])) {
+        let time_ns = self.scene_now_ns;
+        loop {
+            let mut batch = [RegisterWrite {
+                time_ns,
+                bus: Bus::Spi,
+                address: 0,
+                register: 0,
+                value: 0,
+            }; WRITES_PER_FRAME];
+            let mut n = 0;
+            while n < WRITES_PER_FRAME {
+                let Some(w) = self.chip.pop_write() else {
+                    break;
+                };
+                if let Some(slot) = batch.get_mut(n) {
+                    *slot = wire_write(&w, time_ns);
+                }
+                n += 1;
+            }
+            let total = self.chip.write_log().dropped();
+            let dropped = total.wrapping_sub(self.writes_dropped_seen);
+            if n == 0 && dropped == 0 {
+                return;
+            }
+            self.writes_dropped_seen = total;
+            let writes = batch.get(..n).unwrap_or(&[]);
+            self.send(
+                &Message::RegisterWrites(RegisterWriteBatch::new(dropped, writes)),
+                tx,
+            );
+        }
+    }
+}
+
+fn wire_write(w: &chip::RegisterWrite, time_ns: u64) -> RegisterWrite {
+    let (bus, address) = match w.bus {
+        chip::Bus::Spi => (Bus::Spi, 0),
+        chip::Bus::I2c => (Bus::I2c, w.device),
+        chip::Bus::Aux => (Bus::AuxMaster, w.device),
+    };
+    RegisterWrite {
+        time_ns,
+        bus,
+        address,
+        register: w.register,
+        value: w.value,
+    }
+}

@@ -1,0 +1,8 @@
+//! The firmware link handler against a fake clock and in-memory byte streams: the host side is
+//! the protocol's own `Encoder`, the device's output is decoded with the shared `Accumulator`.
+
+mod common;
+mod model;
+mod robustness;
+mod session;
+mod streaming;

@@ -1,0 +1,202 @@
+//! Handshake, configuration, telemetry, register writes and refusals.
+
+use margemu_firmware::chip::SpiTarget;
+use margemu_firmware::link::DEFAULT_TELEMETRY_PERIOD_NS;
+use margemu_model::perturbation::PerturbationConfig;
+use margemu_model::sensor::MargConfig;
+use margemu_protocol::link::{
+    Bus, Chips, Configure, Credit, DeviceState, ErrorCode, Message, ModelParams, Modes,
+    RegisterFile, RegisterOverride, ResetCause, Source, Start,
+};
+
+use crate::common::*;
+
+#[test]
+fn handshake_answers_with_capabilities_after_the_boot_reset() {
+    let mut dev = Dev::new();
+    let mut host = Host::new();
+    host.hello(&mut dev, 0xDEAD_BEEF);
+    let out = poll(&mut dev, 0);
+    assert_eq!(out[0], Out::Reset(ResetCause::PowerOn));
+    let Out::HelloAck(ack) = &out[1] else {
+        panic!("{out:?}")
+    };
+    assert_eq!(ack.session, 0xDEAD_BEEF);
+    assert_eq!(ack.protocol_version, margemu_protocol::PROTOCOL_VERSION);
+    let caps = ack.capabilities;
+    assert!(caps.chips.contains(Chips::MPU9250 | Chips::MPU6500));
+    assert!(caps.modes.contains(Modes::IMAGES | Modes::MODEL));
+    assert_eq!((caps.buffer_capacity, caps.max_batch), (CAP as u32, 69));
+    assert_eq!(out.len(), 2, "idle: no credit, no telemetry");
+    assert_eq!(poll(&mut dev, 1_000 * MS), vec![]);
+}
+
+#[test]
+fn configure_grants_the_whole_buffer_and_applies_overrides() {
+    let mut dev = Dev::new();
+    let mut host = Host::new();
+    host.hello(&mut dev, 1);
+    poll(&mut dev, 0);
+    let mut cfg = Configure::new(0x73, rate_1khz());
+    cfg.overrides
+        .push(RegisterOverride {
+            file: RegisterFile::Mpu9250,
+            register: 0x1B,
+            value: 0x18,
+        })
+        .unwrap();
+    cfg.overrides
+        .push(RegisterOverride {
+            file: RegisterFile::Ak8963,
+            register: 0x0A,
+            value: 0x16,
+        })
+        .unwrap();
+    host.configure(&mut dev, cfg);
+    let out = poll(&mut dev, 0);
+    assert_eq!(
+        out,
+        vec![Out::Credit(Credit {
+            next_index: 0,
+            limit: CAP as u64
+        })],
+        "overrides are not reported as writes of the device under test"
+    );
+    assert_eq!(dev.state(), DeviceState::Configured);
+    assert_eq!(dev.chip().peek(0x75), 0x73);
+    assert_eq!(dev.chip().peek(0x1B), 0x18);
+    assert_eq!(dev.chip().ak8963().unwrap().peek(0x0A), 0x16);
+    assert_eq!(dev.chip().peek(0x37) & 0x02, 0, "bypass restored");
+}
+
+#[test]
+fn refusals_are_answered_and_counted() {
+    let mut dev = Dev::new();
+    let mut host = Host::new();
+    host.hello(&mut dev, 1);
+    poll(&mut dev, 0);
+    host.send(&mut dev, &Message::Start(Start { t0_ns: 0 }), 0);
+    host.configure(&mut dev, Configure::new(0x42, rate_1khz()));
+    let mut p = ModelParams::new(1, rate_1khz(), MargConfig::default());
+    p.perturbation = Some(PerturbationConfig::default());
+    host.configure(
+        &mut dev,
+        Configure {
+            source: Source::Model(p),
+            ..Configure::new(0x71, rate_1khz())
+        },
+    );
+    let out = poll(&mut dev, 0);
+    let codes: Vec<_> = out
+        .iter()
+        .filter_map(|o| match o {
+            Out::Error(e) => Some((e.code, e.seq)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        codes,
+        vec![
+            (ErrorCode::NotConfigured, 1),
+            (ErrorCode::UnsupportedChip, 2),
+            (ErrorCode::UnsupportedMode, 3)
+        ]
+    );
+    assert_eq!(dev.counters().rx.rejected_messages, 3);
+    assert_eq!(dev.state(), DeviceState::Idle);
+}
+
+#[test]
+fn telemetry_is_periodic_while_configured() {
+    let (mut dev, _host) = configured();
+    assert_eq!(poll(&mut dev, DEFAULT_TELEMETRY_PERIOD_NS - 1), vec![]);
+    let out = poll(&mut dev, DEFAULT_TELEMETRY_PERIOD_NS);
+    let t = telemetry(&out).expect("telemetry");
+    assert_eq!(t.state, DeviceState::Configured);
+    assert_eq!((t.samples_served, t.buffer_level), (0, 0));
+    assert_eq!(t.credit_limit, CAP as u64);
+    assert_eq!(credits(&out).len(), 1, "a credit goes with every telemetry");
+    assert_eq!(poll(&mut dev, DEFAULT_TELEMETRY_PERIOD_NS + 1), vec![]);
+}
+
+#[test]
+fn register_writes_of_the_device_under_test_are_reported() {
+    let (mut dev, mut host) = configured();
+    host.images(&mut dev, 0, &images(0, 4), 0);
+    host.start(&mut dev, 0, 0);
+    poll(&mut dev, 0);
+    poll(&mut dev, 2 * MS);
+    let chip = dev.chip_mut();
+    for (reg, value) in [(0x1B, 0x08), (0x6B, 0x01)] {
+        chip.select();
+        chip.exchange(reg);
+        chip.exchange(value);
+        chip.deselect();
+    }
+    let out = poll(&mut dev, 2 * MS + 10);
+    let writes: Vec<_> = out
+        .iter()
+        .filter_map(|o| match o {
+            Out::Writes(d, w) => Some((*d, w.clone())),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(writes.len(), 1);
+    let (dropped, w) = &writes[0];
+    assert_eq!(*dropped, 0);
+    let got: Vec<_> = w
+        .iter()
+        .map(|w| (w.time_ns, w.bus, w.address, w.register, w.value))
+        .collect();
+    assert_eq!(
+        got,
+        vec![
+            (2 * MS + 10, Bus::Spi, 0, 0x1B, 0x08),
+            (2 * MS + 10, Bus::Spi, 0, 0x6B, 0x01)
+        ]
+    );
+    // Writes beyond the chip's log are counted as dropped in the next batch.
+    let chip = dev.chip_mut();
+    for i in 0..200u32 {
+        chip.select();
+        chip.exchange(0x19);
+        chip.exchange(i as u8);
+        chip.deselect();
+    }
+    let out = poll(&mut dev, 3 * MS);
+    let (dropped, n): (u32, usize) = out
+        .iter()
+        .filter_map(|o| match o {
+            Out::Writes(d, w) => Some((*d, w.len())),
+            _ => None,
+        })
+        .fold((0, 0), |(d, n), (dd, nn)| (d + dd, n + nn));
+    assert_eq!((dropped, n), (72, 128));
+}
+
+#[test]
+fn hello_resets_the_session() {
+    let (mut dev, mut host) = configured();
+    host.images(&mut dev, 0, &images(0, 8), 0);
+    host.hello(&mut dev, 9);
+    let out = poll(&mut dev, 0);
+    assert!(
+        matches!(&out[..], [Out::HelloAck(a)] if a.session == 9),
+        "{out:?}"
+    );
+    assert_eq!((dev.state(), dev.buffer_level()), (DeviceState::Idle, 0));
+}
+
+#[test]
+fn device_size_is_bounded() {
+    use margemu_firmware::link::Device;
+    let sizes = [
+        core::mem::size_of::<Device<64>>(),
+        core::mem::size_of::<Device<128>>(),
+        core::mem::size_of::<Device<256>>(),
+    ];
+    eprintln!("size_of Device<64>, <128>, <256>: {sizes:?}");
+    // Accumulator + encoder scratch + wire buffer (~4.6 KB), the chip, the model, and the ring
+    // (one slot of ~60 bytes per sample).
+    assert!(sizes[1] < 24 * 1024, "{sizes:?}");
+}
