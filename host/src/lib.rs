@@ -11,6 +11,7 @@
 //! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
+//! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
 //! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs.
 #![warn(missing_docs)]
@@ -19,6 +20,7 @@ pub mod analysis;
 pub mod bench;
 pub mod bus;
 pub mod csv_column;
+pub mod loopback;
 pub mod marg;
 pub mod motion;
 pub mod output;

@@ -185,6 +185,8 @@ struct Core<const N: usize> {
     credit_pending: bool,
     credit_sent_limit: u64,
     telemetry_pending: bool,
+    /// Stop arrived with samples still buffered (image mode): serve them, then stop.
+    draining: bool,
     next_telemetry_local_ns: u64,
     writes_dropped_seen: u32,
     served: [ServedSample; SERVED_CAPACITY],
@@ -229,6 +231,7 @@ impl<const N: usize> Device<N> {
                 credit_pending: false,
                 credit_sent_limit: 0,
                 telemetry_pending: false,
+                draining: false,
                 next_telemetry_local_ns: 0,
                 writes_dropped_seen: 0,
                 served: [ServedSample::default(); SERVED_CAPACITY],
@@ -445,10 +448,24 @@ impl<const N: usize> Core<N> {
             next_k: u64::try_from(k0).unwrap_or(u64::MAX),
         });
         self.scene_now_ns = s.t0_ns;
+        self.draining = false;
         self.state = DeviceState::Running;
     }
 
+    /// Stop. In image mode with samples still buffered the stop is graceful: no more samples
+    /// are coming, so the buffered ones are served at their instants and the device stops at
+    /// the first instant it has nothing for (no underrun is counted for it). Otherwise, and in
+    /// kinematics mode, it stops at once.
     fn stop(&mut self, now_ns: u64) {
+        if self.state == DeviceState::Running && self.model.is_none() && self.ring.level() > 0 {
+            self.draining = true;
+            return;
+        }
+        self.finish_stop(now_ns);
+    }
+
+    fn finish_stop(&mut self, now_ns: u64) {
+        self.draining = false;
         if self.state == DeviceState::Running {
             self.scene_now_ns = self.scene_time(now_ns);
             self.state = DeviceState::Stopped;
@@ -507,6 +524,15 @@ impl<const N: usize> Core<N> {
             let t = session.rate.sample_time_ns(clock.next_k);
             if t > now || clock.next_k == u64::MAX {
                 break;
+            }
+            if self.draining && self.ring.level() == 0 {
+                // Nothing left after a Stop: stop at this instant, serving nothing for it.
+                self.clock = Some(clock);
+                self.draining = false;
+                self.state = DeviceState::Stopped;
+                self.scene_now_ns = t;
+                self.telemetry_pending = true;
+                return;
             }
             self.serve(clock.next_k, t);
             self.log_served(tx);

@@ -99,6 +99,8 @@ fn underrun_holds_the_last_sample_and_is_counted() {
     poll(&mut dev, 9 * MS);
     assert_eq!(burst_sensors(&mut dev), image(9)[..14]);
     assert_eq!((dev.counters().served, dev.counters().underruns), (10, 5));
+    // Stop is graceful: samples 10 and 11 are still buffered, so they are served at their
+    // instants, and the device stops at instant 12 without counting an underrun for it.
     host.send(&mut dev, &Message::Stop, 9 * MS);
     let out = poll(&mut dev, 20 * MS);
     let flags: Vec<_> = served(&out).iter().map(|(k, s)| (*k, s.underrun)).collect();
@@ -106,20 +108,25 @@ fn underrun_holds_the_last_sample_and_is_counted() {
     assert_eq!(held, served_entry(&image(2), true));
     assert_eq!(
         flags,
-        (0..10)
+        (0..12)
             .map(|k| (k, (3..8).contains(&k)))
             .collect::<Vec<_>>()
     );
+    assert_eq!((dev.counters().served, dev.counters().underruns), (12, 5));
     let t = telemetry(&out).unwrap();
     assert_eq!(t.state, DeviceState::Stopped);
-    assert_eq!((t.samples_served, t.underruns, t.overruns), (10, 5, 0));
-    assert_eq!((t.last_served_index, t.last_served_time_ns), (9, 9 * MS));
+    assert_eq!((t.samples_served, t.underruns, t.overruns), (12, 5, 0));
+    assert_eq!((t.last_served_index, t.last_served_time_ns), (11, 11 * MS));
     assert_eq!(
         (t.buffer_level, t.next_index, t.credit_limit),
-        (2, 12, 10 + CAP as u64)
+        (0, 12, 12 + CAP as u64)
     );
-    assert_eq!(t.time_ns, 9 * MS);
-    assert_eq!(dev.counters().served, 10, "stopped: nothing more served");
+    assert_eq!(
+        t.time_ns,
+        12 * MS,
+        "stopped at the first instant with nothing to serve"
+    );
+    assert_eq!(dev.counters().served, 12, "stopped: nothing more served");
 }
 
 #[test]

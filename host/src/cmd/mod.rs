@@ -2,6 +2,7 @@
 
 pub mod analyze;
 pub mod bench;
+pub mod loopback;
 pub mod ports;
 pub mod scene;
 pub mod simulate;
@@ -13,6 +14,8 @@ pub enum Command {
     /// Inspect scene files.
     #[command(subcommand)]
     Scene(scene::Cmd),
+    /// Stream a scene to the firmware's link handler behind a pseudo-terminal pair (no hardware).
+    Loopback(loopback::Cmd),
     /// Simulate a scene and write its run directory (truth.csv, meta.toml).
     Simulate(simulate::Cmd),
     /// Analyse recorded columns (noise: Allan deviation and PSD).
@@ -32,6 +35,7 @@ impl Command {
         match self {
             Command::Scene(c) => c.run(),
             Command::Simulate(c) => c.run(),
+            Command::Loopback(c) => c.run(),
             Command::Bench(c) => c.run(),
             Command::Analyze(c) => c.run(),
             Command::Stream(c) => c.run(),

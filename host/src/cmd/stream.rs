@@ -58,53 +58,65 @@ impl Cmd {
         };
         let port =
             open_port(&self.port, self.baud).with_context(|| format!("opening {}", self.port))?;
-        let session = Session::new(&scene, config, &dir)
-            .with_context(|| format!("preparing the session in {}", dir.display()))?;
-        eprintln!("image settings: {:?}", session.image_settings());
-        let stop = session.stop_flag();
-        ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
-            .context("installing the Ctrl-C handler")?;
-        let bar = ProgressBar::new(scene.samples());
-        bar.set_style(
-            ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}")
-                .expect("valid template"),
-        );
-        let summary = session
-            .run_on_port(port, |p| show(&bar, p))
-            .with_context(|| {
-                format!(
-                    "streaming {} to {} (logs in {})",
-                    scene.path.display(),
-                    self.port,
-                    dir.display()
-                )
-            });
-        bar.finish_and_clear();
-        let summary = summary?;
-        let t = summary.telemetry;
-        println!(
-            "sent {}/{} samples in {:.2} s to {}; served {}, underruns {}, overruns {}, device CRC errors {}, host receive errors {}",
-            summary.sent,
-            summary.samples,
-            summary.elapsed.as_secs_f64(),
-            self.port,
-            t.map_or(0, |t| t.samples_served),
-            t.map_or(0, |t| t.underruns),
-            t.map_or(0, |t| t.overruns),
-            t.map_or(0, |t| t.crc_errors),
-            summary.host_rx.crc_errors + summary.host_rx.framing_errors,
-        );
-        let j = summary.jitter;
-        println!(
-            "pacing jitter over {} batches: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; logs in {}",
-            j.batches,
-            j.p50_ns as f64 / 1e3,
-            j.p99_ns as f64 / 1e3,
-            j.max_ns as f64 / 1e3,
-            summary.dir.display()
-        );
+        stream_to(&scene, config, &dir, port, &self.port)?;
         Ok(())
     }
+}
+
+/// Streams `scene` over `port` (named `label` in messages) with a progress line, prints the
+/// summary, and returns it; the session directory is `dir`.
+pub fn stream_to(
+    scene: &Scene,
+    config: StreamConfig,
+    dir: &std::path::Path,
+    port: serialport::TTYPort,
+    label: &str,
+) -> Result<margemu::stream::Summary> {
+    let session = Session::new(scene, config, dir)
+        .with_context(|| format!("preparing the session in {}", dir.display()))?;
+    eprintln!("image settings: {:?}", session.image_settings());
+    let stop = session.stop_flag();
+    ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
+        .context("installing the Ctrl-C handler")?;
+    let bar = ProgressBar::new(scene.samples());
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),
+    );
+    let summary = session
+        .run_on_port(port, |p| show(&bar, p))
+        .with_context(|| {
+            format!(
+                "streaming {} to {} (logs in {})",
+                scene.path.display(),
+                label,
+                dir.display()
+            )
+        });
+    bar.finish_and_clear();
+    let summary = summary?;
+    let t = summary.telemetry;
+    println!(
+        "sent {}/{} samples in {:.2} s to {}; served {}, underruns {}, overruns {}, device CRC errors {}, host receive errors {}",
+        summary.sent,
+        summary.samples,
+        summary.elapsed.as_secs_f64(),
+        label,
+        t.map_or(0, |t| t.samples_served),
+        t.map_or(0, |t| t.underruns),
+        t.map_or(0, |t| t.overruns),
+        t.map_or(0, |t| t.crc_errors),
+        summary.host_rx.crc_errors + summary.host_rx.framing_errors,
+    );
+    let j = summary.jitter;
+    println!(
+        "pacing jitter over {} batches: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; logs in {}",
+        j.batches,
+        j.p50_ns as f64 / 1e3,
+        j.p99_ns as f64 / 1e3,
+        j.max_ns as f64 / 1e3,
+        summary.dir.display()
+    );
+    Ok(summary)
 }
 
 fn show(bar: &ProgressBar, p: &Progress) {
