@@ -9,10 +9,11 @@
 //!     return;
 //! }
 //! let elf = qemu::board_elf().unwrap();
-//! let (mut qemu, mut uart0) = Qemu::boot(&elf).unwrap();
-//! println!("{}", uart0.read_line(Duration::from_secs(5)).unwrap());
-//! uart0.write_all(b"q").unwrap();
-//! assert!(qemu.wait_exit(Duration::from_secs(5)).unwrap().success());
+//! let (qemu, mut uart0) = Qemu::boot(&elf).unwrap();
+//! // The firmware speaks the binary link: the power-on Reset frame opens with a delimiter.
+//! let frame = uart0.read_until(0x00, Duration::from_secs(5)).unwrap();
+//! println!("{frame:02x?}");
+//! drop(qemu); // kills and reaps QEMU
 //! ```
 //!
 //! QEMU starts paused (`-S`) with its monitor on its stdin and stdout. [`Qemu::boot`] opens the
@@ -32,6 +33,7 @@ use std::sync::{mpsc, Arc, Mutex, OnceLock};
 use std::thread;
 use std::time::{Duration, Instant};
 
+use margemu_protocol::link::{Accumulator, FeedResult, FrameRepr, Message};
 use serialport::TTYPort;
 
 use crate::workspace_root;
@@ -363,6 +365,37 @@ fn pty_path(line: &str) -> Option<PathBuf> {
     label.contains("serial0").then(|| PathBuf::from(path))
 }
 
+/// Decodes link frames from a byte stream (any chunking), as the host's receiver does.
+#[derive(Default)]
+pub struct LinkDecoder {
+    accumulator: Accumulator,
+    /// Damaged frames and bytes between frames (the accumulator's errors), counted.
+    pub damaged: u64,
+}
+
+impl LinkDecoder {
+    /// Feeds `bytes`; calls `on_message` with every intact frame's message, in order
+    /// (frames whose message does not parse count as damaged).
+    pub fn feed(&mut self, mut bytes: &[u8], on_message: &mut impl FnMut(&Message<'_>)) {
+        while !bytes.is_empty() {
+            match self.accumulator.feed(bytes) {
+                FeedResult::Consumed => break,
+                FeedResult::Success { frame, remaining } => {
+                    match FrameRepr::parse(&frame) {
+                        Ok(repr) => on_message(&repr.message),
+                        Err(_) => self.damaged += 1,
+                    }
+                    bytes = remaining;
+                }
+                other => {
+                    self.damaged += 1;
+                    bytes = other.remaining();
+                }
+            }
+        }
+    }
+}
+
 /// A serial port (here, a PTY) with deadline-bounded reads.
 pub struct SerialLink {
     port: TTYPort,
@@ -419,6 +452,12 @@ impl SerialLink {
             self.fill(deadline, timeout)?;
         }
         Ok(self.pending.drain(..n).collect())
+    }
+
+    /// The port itself, for a [`Session`](margemu::stream::Session) or other unbuffered use;
+    /// bytes already buffered here are dropped.
+    pub fn into_port(self) -> TTYPort {
+        self.port
     }
 
     /// The port itself, for settings and unbuffered use (bytes already buffered here stay here).
