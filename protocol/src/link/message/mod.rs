@@ -57,60 +57,39 @@ pub use status::{Credit, DeviceState, Telemetry, TELEMETRY_LEN};
 use super::wire::{Reader, Writer};
 use super::{Error, MAX_PAYLOAD_LEN};
 
-/// The kind byte of a frame: which message its payload holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[repr(u8)]
-pub enum Kind {
-    /// [`Hello`].
-    Hello = 0x01,
-    /// [`Configure`].
-    Configure = 0x02,
-    /// [`Start`].
-    Start = 0x03,
-    /// [`Message::Stop`].
-    Stop = 0x04,
-    /// [`ImageBatch`].
-    Images = 0x10,
-    /// [`KinematicsBatch`].
-    Kinematics = 0x11,
-    /// [`HelloAck`].
-    HelloAck = 0x81,
-    /// [`Credit`].
-    Credit = 0x82,
-    /// [`Telemetry`].
-    Telemetry = 0x83,
-    /// [`RegisterWriteBatch`].
-    RegisterWrites = 0x84,
-    /// [`Reset`].
-    Reset = 0x85,
-    /// [`ErrorReport`].
-    Error = 0x86,
-    /// [`ServedBatch`].
-    Served = 0x87,
+code_enum! {
+    /// The kind byte of a frame: which message its payload holds.
+    pub enum Kind {
+        /// [`Hello`].
+        Hello = 0x01,
+        /// [`Configure`].
+        Configure = 0x02,
+        /// [`Start`].
+        Start = 0x03,
+        /// [`Message::Stop`].
+        Stop = 0x04,
+        /// [`ImageBatch`].
+        Images = 0x10,
+        /// [`KinematicsBatch`].
+        Kinematics = 0x11,
+        /// [`HelloAck`].
+        HelloAck = 0x81,
+        /// [`Credit`].
+        Credit = 0x82,
+        /// [`Telemetry`].
+        Telemetry = 0x83,
+        /// [`RegisterWriteBatch`].
+        RegisterWrites = 0x84,
+        /// [`Reset`].
+        Reset = 0x85,
+        /// [`ErrorReport`].
+        Error = 0x86,
+        /// [`ServedBatch`].
+        Served = 0x87,
+    }
 }
 
 impl Kind {
-    /// The kind of a kind byte, if this version knows it.
-    pub fn from_u8(byte: u8) -> Option<Self> {
-        Some(match byte {
-            0x01 => Self::Hello,
-            0x02 => Self::Configure,
-            0x03 => Self::Start,
-            0x04 => Self::Stop,
-            0x10 => Self::Images,
-            0x11 => Self::Kinematics,
-            0x81 => Self::HelloAck,
-            0x82 => Self::Credit,
-            0x83 => Self::Telemetry,
-            0x84 => Self::RegisterWrites,
-            0x85 => Self::Reset,
-            0x86 => Self::Error,
-            0x87 => Self::Served,
-            _ => return None,
-        })
-    }
-
     /// Whether the host sends this kind (bit 7 clear).
     pub fn is_host_to_device(self) -> bool {
         (self as u8) & 0x80 == 0
