@@ -63,11 +63,6 @@ impl SampleClock {
         self.den as f64 * 1e9 / self.num as f64
     }
 
-    /// The nominal period in seconds (for formulas and reports).
-    pub fn period_seconds(&self) -> f64 {
-        self.num as f64 / self.den as f64 * 1e-9
-    }
-
     /// The instant at which sample `k` is latched.
     pub fn instant(&self, k: u64) -> Nanos {
         ((k as u128 * self.num as u128) / self.den as u128) as Nanos

@@ -72,13 +72,6 @@ impl Psd {
             .collect()
     }
 
-    /// Median density over `[lo, hi]` Hz (robust level of a flat band).
-    pub fn median_in(&self, lo: f64, hi: f64) -> Option<f64> {
-        let mut band = self.band(lo, hi);
-        band.sort_by(f64::total_cmp);
-        band.get(band.len() / 2).copied()
-    }
-
     /// Mean density over `[lo, hi]` Hz.
     pub fn mean_in(&self, lo: f64, hi: f64) -> Option<f64> {
         let band = self.band(lo, hi);
