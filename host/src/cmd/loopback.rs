@@ -2,10 +2,10 @@
 //! the host behind a real pseudo-terminal pair, the scene streams to it exactly as to a board,
 //! and every image the device served is checked against the host's prediction.
 
-use super::stream::stream_to;
+use super::stream::{prepare, stream_to};
 use anyhow::{bail, Context, Result};
 use margemu::scene::Scene;
-use margemu::stream::{predict, ImageSettings, StreamConfig};
+use margemu::stream::{ImageSettings, StreamConfig};
 use margemu_protocol::link::CRC32C;
 use serialport::{SerialPort, TTYPort};
 use std::path::PathBuf;
@@ -27,7 +27,6 @@ impl Cmd {
             PathBuf::from("sessions").join(format!("{stem}-loopback"))
         });
         let settings = ImageSettings::for_scene(&scene);
-        let expected = predict(&scene, &settings).context("predicting the scene's images")?;
         let (host_end, device_end) = TTYPort::pair().context("opening a pseudo-terminal pair")?;
         let label = device_end
             .name()
@@ -38,15 +37,21 @@ impl Cmd {
             images: Some(settings),
             ..StreamConfig::default()
         };
-        let streamed = stream_to(&scene, config, &dir, host_end, &label);
+        let session = prepare(&scene, config, &dir)?;
+        let expected: Vec<u32> = session
+            .samples()
+            .iter()
+            .map(|s| CRC32C.checksum(&s.image))
+            .collect();
+        let streamed = stream_to(&scene, session, &dir, host_end, &label);
         let report = device.stop();
         streamed?;
         let mut matched = 0usize;
         for &(index, crc, underrun) in &report.served {
-            let Some(sample) = expected.get(index as usize) else {
+            let Some(&predicted) = expected.get(index as usize) else {
                 continue;
             };
-            if underrun || crc != CRC32C.checksum(&sample.image) {
+            if underrun || crc != predicted {
                 bail!(
                     "the device served sample {index} differently from the prediction ({}); logs in {}",
                     if underrun { "an underrun" } else { "CRC mismatch" },

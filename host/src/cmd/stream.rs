@@ -58,22 +58,32 @@ impl Cmd {
         };
         let port =
             open_port(&self.port, self.baud).with_context(|| format!("opening {}", self.port))?;
-        stream_to(&scene, config, &dir, port, &self.port)?;
+        stream_to(
+            &scene,
+            prepare(&scene, config, &dir)?,
+            &dir,
+            port,
+            &self.port,
+        )?;
         Ok(())
     }
 }
 
-/// Streams `scene` over `port` (named `label` in messages) with a progress line, prints the
-/// summary, and returns it; the session directory is `dir`.
+/// Prepares the session of `scene` in `dir` (every image predicted).
+pub fn prepare(scene: &Scene, config: StreamConfig, dir: &std::path::Path) -> Result<Session> {
+    Session::new(scene, config, dir)
+        .with_context(|| format!("preparing the session in {}", dir.display()))
+}
+
+/// Runs `session` of `scene` over `port` (named `label` in messages) with a progress line,
+/// prints the summary, and returns it; the session directory is `dir`.
 pub fn stream_to(
     scene: &Scene,
-    config: StreamConfig,
+    session: Session,
     dir: &std::path::Path,
     port: serialport::TTYPort,
     label: &str,
 ) -> Result<margemu::stream::Summary> {
-    let session = Session::new(scene, config, dir)
-        .with_context(|| format!("preparing the session in {}", dir.display()))?;
     eprintln!("image settings: {:?}", session.image_settings());
     let stop = session.stop_flag();
     ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
