@@ -157,8 +157,12 @@ pub fn board_target_dir() -> PathBuf {
         .unwrap_or_else(|| workspace_root().join("target/thumbv7em"))
 }
 
-/// The board ELF, built once per test process (release profile).
+/// The board ELF, built once per test process (release profile); `$MARGEMU_BOARD_ELF`, if set,
+/// names a prebuilt one to use instead (e.g. a variant under measurement).
 pub fn board_elf() -> io::Result<PathBuf> {
+    if let Some(elf) = std::env::var_os("MARGEMU_BOARD_ELF") {
+        return Ok(PathBuf::from(elf));
+    }
     static ELF: OnceLock<Result<PathBuf, String>> = OnceLock::new();
     ELF.get_or_init(|| build_board(&board_dir(), &board_target_dir()).map_err(|e| e.to_string()))
         .clone()

@@ -1,5 +1,5 @@
-//! Polled time base on CMSDK APB TIMER0 (ARM DDI0479C), at `0x4000_0000` on the MPS2
-//! AN385/AN386 images, clocked by PCLK (25 MHz).
+//! CMSDK APB timers (ARM DDI0479C), clocked by PCLK (25 MHz): TIMER0 (`0x4000_0000`, IRQ 8) as
+//! the polled time base, TIMER1 (`0x4000_1000`, IRQ 9) as the periodic wake-up tick.
 //!
 //! | offset | name      | bits                                                              |
 //! |--------|-----------|-------------------------------------------------------------------|
@@ -12,11 +12,16 @@
 //! adds the ticks elapsed since its previous call (wrapping subtraction of the down-counter), so
 //! it must be called at least once per wrap period; the main loop calls it every iteration.
 //! (The DWT cycle counter is not modelled by QEMU, hence a peripheral timer.)
+//!
+//! [`Tick`] counts down from `RELOAD` and raises its interrupt each time it reaches 0; its only
+//! job is to wake the core from WFI in time for the next sample instant.
 
 use core::ptr::{read_volatile, write_volatile};
 
 /// Base address of TIMER0 on the MPS2 AN385/AN386 images.
 pub const TIMER0_BASE: usize = 0x4000_0000;
+/// Base address of TIMER1 on the MPS2 AN385/AN386 images.
+pub const TIMER1_BASE: usize = 0x4000_1000;
 
 const CTRL: usize = 0x00;
 const VALUE: usize = 0x04;
@@ -24,6 +29,7 @@ const RELOAD: usize = 0x08;
 const INTSTATUS: usize = 0x0C;
 
 const CTRL_EN: u32 = 1 << 0;
+const CTRL_IRQ_EN: u32 = 1 << 3;
 
 /// A free-running CMSDK timer extended to a 64-bit nanosecond clock by polling.
 pub struct Timer {
@@ -79,6 +85,45 @@ impl Timer {
 
     fn write(&mut self, offset: usize, value: u32) {
         // SAFETY: as in `read`.
+        unsafe { write_volatile((self.base + offset) as *mut u32, value) }
+    }
+}
+
+/// A CMSDK timer raising its interrupt periodically. A copy is only an address (the handler
+/// acknowledges through its own copy).
+#[derive(Clone, Copy)]
+pub struct Tick {
+    base: usize,
+}
+
+impl Tick {
+    /// Takes the timer at `base`.
+    ///
+    /// # Safety
+    ///
+    /// `base` must be the base of a CMSDK APB timer driven only through copies of this value.
+    pub const unsafe fn new(base: usize) -> Self {
+        Self { base }
+    }
+
+    /// Starts the interrupt every `period_ticks` PCLK cycles (at least 2).
+    pub fn start(&self, period_ticks: u32) {
+        let reload = period_ticks.max(2) - 1;
+        self.write(CTRL, 0);
+        self.write(RELOAD, reload);
+        self.write(VALUE, reload);
+        self.write(INTSTATUS, 1);
+        self.write(CTRL, CTRL_EN | CTRL_IRQ_EN);
+    }
+
+    /// Acknowledges the interrupt (from its handler; INTSTATUS is write-one-to-clear, so this
+    /// cannot disturb the counter).
+    pub fn clear_interrupt(&self) {
+        self.write(INTSTATUS, 1);
+    }
+
+    fn write(&self, offset: usize, value: u32) {
+        // SAFETY: `new`'s contract: `base + offset` is a register of a CMSDK timer.
         unsafe { write_volatile((self.base + offset) as *mut u32, value) }
     }
 }

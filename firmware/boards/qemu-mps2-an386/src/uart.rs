@@ -1,5 +1,6 @@
-//! Polled driver for the CMSDK APB UART (ARM DDI0479C, "Cortex-M System Design Kit TRM"), the
-//! UART of the MPS2 FPGA images and of QEMU's `cmsdk-apb-uart` model.
+//! Register driver for the CMSDK APB UART (ARM DDI0479C, "Cortex-M System Design Kit TRM"), the
+//! UART of the MPS2 FPGA images and of QEMU's `cmsdk-apb-uart` model. [`crate::serial`] drives it
+//! from its interrupts.
 //!
 //! Registers, 32 bits each, at offsets from the base (UART0 of AN385/AN386 is at `0x4000_4000`,
 //! RX IRQ 0, TX IRQ 1; the TX/RX overrun IRQs of UART0..2 are ORed onto IRQ 12):
@@ -12,11 +13,15 @@
 //! | 0x0C   | INTSTATUS | 0 TX, 1 RX, 2 TX overrun, 3 RX overrun (W1C)                           |
 //! | 0x10   | BAUDDIV   | [19:0] PCLK / baud, at least 16 (QEMU ignores smaller values)          |
 //!
-//! There is no FIFO: one byte of buffer each way. Under QEMU the baud rate only reaches the
-//! host side as a termios setting; bytes move as fast as the chardev takes them, and QEMU does
-//! not accept a new RX byte until the guest has read DATA (no RX overrun from the host side).
+//! There is no FIFO: one byte of buffer each way. The RX interrupt is raised when a byte arrives;
+//! the TX interrupt when the transmit buffer empties (going from TXFULL to not full).
+//!
+//! Under QEMU (7.2, `hw/char/cmsdk-apb-uart.c`) the baud rate only reaches the host side as a
+//! termios setting. A byte written to DATA goes straight to the chardev (one `write` system call
+//! per byte), so TXFULL clears within the store unless the host side is full. RX takes one byte
+//! per turn of QEMU's main loop: the chardev is offered a byte only while RXFULL is clear, and
+//! reading DATA wakes the main loop for the next one, so the host side never overruns it.
 
-use core::fmt;
 use core::ptr::{read_volatile, write_volatile};
 
 /// Base address of UART0 on the MPS2 AN385/AN386 images.
@@ -25,63 +30,65 @@ pub const UART0_BASE: usize = 0x4000_4000;
 const DATA: usize = 0x00;
 const STATE: usize = 0x04;
 const CTRL: usize = 0x08;
+const INTSTATUS: usize = 0x0C;
 const BAUDDIV: usize = 0x10;
 
 const STATE_TXFULL: u32 = 1 << 0;
 const STATE_RXFULL: u32 = 1 << 1;
+const STATE_TX_OVERRUN: u32 = 1 << 2;
 const STATE_RX_OVERRUN: u32 = 1 << 3;
 const CTRL_TX_EN: u32 = 1 << 0;
 const CTRL_RX_EN: u32 = 1 << 1;
+const CTRL_TX_INT: u32 = 1 << 2;
+const CTRL_RX_INT: u32 = 1 << 3;
+const INT_TX: u32 = 1 << 0;
+const INT_RX: u32 = 1 << 1;
 
 /// The smallest divider the CMSDK UART accepts.
 const BAUDDIV_MIN: u32 = 16;
 
-/// One CMSDK APB UART, driven by polling (interrupts stay disabled).
+/// One CMSDK APB UART. A copy is only an address: the receive half (DATA reads, INTSTATUS RX)
+/// and the transmit half (DATA writes, INTSTATUS TX) touch disjoint bits, so the RX and TX
+/// interrupt handlers each use their own copy.
+#[derive(Clone, Copy)]
 pub struct Uart {
     base: usize,
 }
 
 impl Uart {
-    /// Takes the UART at `base`.
+    /// The UART at `base`.
     ///
     /// # Safety
     ///
-    /// `base` must be the base of a CMSDK APB UART, and nothing else may drive it while this
-    /// value lives.
+    /// `base` must be the base of a CMSDK APB UART, driven only through copies of this value.
     pub const unsafe fn new(base: usize) -> Self {
         Self { base }
     }
 
-    /// Sets the baud divider for `pclk_hz`/`baud` (8N1 is fixed) and enables TX and RX, with
-    /// every interrupt off.
-    pub fn init(&mut self, pclk_hz: u32, baud: u32) {
+    /// Sets the baud divider for `pclk_hz`/`baud` (8N1 is fixed), clears stale status, and
+    /// enables TX and RX with their interrupts (the overrun interrupts stay off).
+    pub fn init(&self, pclk_hz: u32, baud: u32) {
         let div = (pclk_hz / baud.max(1)).max(BAUDDIV_MIN);
         self.write(CTRL, 0);
         self.write(BAUDDIV, div);
-        self.write(STATE, STATE_RX_OVERRUN | (1 << 2));
-        self.write(CTRL, CTRL_TX_EN | CTRL_RX_EN);
+        self.write(STATE, STATE_RX_OVERRUN | STATE_TX_OVERRUN);
+        self.write(INTSTATUS, INT_TX | INT_RX);
+        self.write(CTRL, CTRL_TX_EN | CTRL_RX_EN | CTRL_TX_INT | CTRL_RX_INT);
     }
 
-    /// Waits until the transmit buffer is free, then sends `byte`.
-    pub fn write_byte(&mut self, byte: u8) {
-        self.flush();
-        self.write(DATA, u32::from(byte));
+    /// Acknowledges the RX interrupt. Call it before reading DATA, so that a byte arriving
+    /// after the read raises the interrupt again.
+    pub fn clear_rx_interrupt(&self) {
+        self.write(INTSTATUS, INT_RX);
     }
 
-    /// Sends every byte of `bytes`.
-    pub fn write_all(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_byte(b);
-        }
-    }
-
-    /// Waits until the last byte written has left the transmit buffer.
-    pub fn flush(&mut self) {
-        while self.read(STATE) & STATE_TXFULL != 0 {}
+    /// Acknowledges the TX interrupt.
+    pub fn clear_tx_interrupt(&self) {
+        self.write(INTSTATUS, INT_TX);
     }
 
     /// The received byte, if one is waiting.
-    pub fn try_read_byte(&mut self) -> Option<u8> {
+    pub fn try_read_byte(&self) -> Option<u8> {
         if self.read(STATE) & STATE_RXFULL != 0 {
             Some(self.read(DATA) as u8)
         } else {
@@ -89,40 +96,22 @@ impl Uart {
         }
     }
 
-    /// Waits for a received byte.
-    #[allow(dead_code)] // the link loop polls with `try_read_byte`
-    pub fn read_byte(&mut self) -> u8 {
-        loop {
-            if let Some(b) = self.try_read_byte() {
-                return b;
-            }
+    /// Sends `byte` if the transmit buffer is free; `false` if it is still full.
+    pub fn try_write_byte(&self, byte: u8) -> bool {
+        if self.read(STATE) & STATE_TXFULL != 0 {
+            return false;
         }
-    }
-
-    /// Whether a received byte was overwritten before it was read; clears the flag.
-    #[allow(dead_code)] // QEMU never overruns RX; for a board with a faster host
-    pub fn take_rx_overrun(&mut self) -> bool {
-        let overrun = self.read(STATE) & STATE_RX_OVERRUN != 0;
-        if overrun {
-            self.write(STATE, STATE_RX_OVERRUN);
-        }
-        overrun
+        self.write(DATA, u32::from(byte));
+        true
     }
 
     fn read(&self, offset: usize) -> u32 {
-        // SAFETY: `new`'s contract: `base + offset` is a register of a CMSDK UART we own.
+        // SAFETY: `new`'s contract: `base + offset` is a register of a CMSDK UART.
         unsafe { read_volatile((self.base + offset) as *const u32) }
     }
 
-    fn write(&mut self, offset: usize, value: u32) {
+    fn write(&self, offset: usize, value: u32) {
         // SAFETY: as in `read`.
         unsafe { write_volatile((self.base + offset) as *mut u32, value) }
-    }
-}
-
-impl fmt::Write for Uart {
-    fn write_str(&mut self, s: &str) -> fmt::Result {
-        self.write_all(s.as_bytes());
-        Ok(())
     }
 }

@@ -1,0 +1,145 @@
+//! QEMU test of source mode (b): the host streams a scene's truth as Kinematics at 200 Hz to the
+//! `qemu-mps2-an386` firmware, which runs the shared sensor model (seeded from the scene, noise
+//! and biases on) at the chip's 1 kHz output rate on the emulated Cortex-M4F. Every image it
+//! served (its Served reports: CRC-32C per image) must equal the host's own prediction, computed
+//! on x86-64 with the same `margemu_model` code ([`ModelStream`]). Passing proves the shared model
+//! is bit-identical on both targets, noise draws included.
+//!
+//! The scene is the paper's Figure 3 bench motion (setpoint steps and 0.5–5 Hz sines, through
+//! the closed-loop dynamics) for 2 s, with the noise densities of section 3.2, constant biases,
+//! hard iron and a warming die. The link is driven with `protocol::link` directly
+//! ([`margemu_tests::drive`]).
+//!
+//! Skipped, with a message, where `qemu-system-arm` or a cross toolchain is missing; under
+//! `CI=true` that is a failure instead.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use margemu::scene::Scene;
+use margemu_tests::drive::{self, Samples, Script};
+use margemu_tests::model_source::ModelStream;
+use margemu_tests::qemu::{self, Qemu};
+use margemu_tests::SENSORS;
+
+/// Figure 3 motion; the [`SENSORS`] are appended.
+const MOTION: &str = r#"
+name = "qemu-model"
+duration = 2.0
+rate = 1000.0
+seed = 5
+[bench]
+initial = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
+[joints.x]
+type = "steps"
+points = [[0.1, 1.5], [1.1, 1.0]]
+[joints.y]
+type = "steps"
+points = [[0.4, 0.6], [1.4, 1.2]]
+[joints.z]
+type = "steps"
+points = [[0.7, 1.4], [1.7, 0.9]]
+[joints.roll]
+type = "sine"
+amplitude = 0.4
+frequency = 2.0
+[joints.pitch]
+type = "sine"
+amplitude = 0.6
+frequency = 0.5
+[joints.yaw]
+type = "sine"
+amplitude = 0.3
+frequency = 5.0
+"#;
+
+/// Output samples per kinematics sample: 1 kHz out, 200 Hz truth.
+const DECIMATION: u32 = 5;
+
+#[test]
+fn model_mode_serves_the_hosts_prediction_bit_for_bit() {
+    if !qemu::prerequisites_or_skip("qemu_model") {
+        return;
+    }
+    let t = Instant::now();
+    let elf = qemu::board_elf().unwrap_or_else(|e| panic!("board ELF: {e}"));
+    let build = t.elapsed();
+
+    let scene = Scene::parse_str(&format!("{MOTION}{SENSORS}"), Path::new("qemu-model.toml"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let stream = ModelStream::from_scene(&scene, DECIMATION).unwrap_or_else(|e| panic!("{e}"));
+    let predicted = stream.predicted_crcs();
+    assert_eq!((predicted.len(), stream.kinematics.len()), (2000, 400));
+    // Noise on: no two consecutive predicted images are equal, although the truth is held.
+    assert!(stream.images.windows(2).all(|w| w[0] != w[1]));
+
+    let script = Script {
+        configure: stream.configure(50_000_000),
+        samples: Samples::Kinematics(&stream.kinematics),
+        sample_rate: stream.params.truth_rate,
+        outputs: predicted.len() as u64,
+        lead: Duration::from_millis(500),
+        batch: 10,
+        timeout: Duration::from_secs(5),
+    };
+    let t = Instant::now();
+    let (qemu, uart0) = Qemu::boot(&elf).unwrap_or_else(|e| panic!("boot: {e}"));
+    let report = drive::run(uart0.into_port(), &script)
+        .unwrap_or_else(|e| panic!("session: {e}\nQEMU printed:\n{}", qemu.output()));
+    let streamed = t.elapsed();
+    drop(qemu);
+
+    let check = report.served.check(&predicted);
+    assert!(
+        check.all_exact(),
+        "{}; {} batches, {} credit stalls, pacing {:?}; telemetry {:?}",
+        check.summary(),
+        report.batches,
+        report.credit_stalls,
+        report.jitter(),
+        report.telemetry
+    );
+    assert_eq!(report.damaged, 0, "damaged device frames");
+    assert_eq!(report.served.duplicates, 0, "instants reported twice");
+    assert!(
+        report.errors.is_empty(),
+        "device errors: {:?}",
+        report.errors
+    );
+    assert!(
+        report.stopped,
+        "no stopped Telemetry: {:?}",
+        report.telemetry
+    );
+    let telemetry = report.telemetry.expect("stopped Telemetry");
+    assert_eq!(
+        (
+            telemetry.overruns,
+            telemetry.crc_errors,
+            telemetry.framing_errors
+        ),
+        (0, 0, 0),
+        "{telemetry:?}"
+    );
+    // Stop reaches the device a little after the scene's end, and every instant it serves after
+    // the last one of the scene lacks its kinematics: underruns after the end, and only there.
+    assert!(telemetry.samples_served >= 2000, "{telemetry:?}");
+    assert_eq!(
+        u64::from(telemetry.underruns),
+        telemetry.samples_served - 2000,
+        "{telemetry:?}"
+    );
+
+    eprintln!(
+        "qemu_model: build {build:.2?}, boot + stream {streamed:.2?}: {} of {} images served \
+         byte-exact (1 kHz model on the Cortex-M4F, 200 Hz kinematics); {} batches, {} credit \
+         stalls, pacing {:?}; device served {} instants, {} underruns (after the scene's end)",
+        check.exact,
+        check.expected,
+        report.batches,
+        report.credit_stalls,
+        report.jitter(),
+        telemetry.samples_served,
+        telemetry.underruns,
+    );
+}
