@@ -6,7 +6,11 @@
 //! cargo bench -p margemu-tests --bench qemu_rates -- --seconds 5 --images 500,1000 --model 1000,8000
 //! ```
 //!
-//! For every rate it boots QEMU, streams a kinematic scene ([`motion_scene`]: sines on all six
+//! First the raw receive path: 60 000 bytes of garbage then a Hello, written as fast as the PTY
+//! takes them, timed to the HelloAck (3 runs): bytes per second into the firmware, and QEMU's
+//! host CPU time per byte.
+//!
+//! Then, for every rate, it boots QEMU, streams a kinematic scene ([`motion_scene`]: sines on all six
 //! joints, the paper's noise densities and biases) for `--seconds` (default 5) and reports:
 //! samples served byte-exact (from the device's Served reports against the host's prediction),
 //! underruns, credit stalls, pacing lateness p50/p99/max of the host's batch writes, and the
@@ -20,16 +24,21 @@
 //!
 //! A rate is sustained when every sample is served byte-exact with no underrun.
 
+use std::io::Write;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
 use margemu::stream::{Session, StreamConfig};
-use margemu_protocol::link::{image_batch_wire_len, CRC32C};
+use margemu_protocol::link::{
+    image_batch_wire_len, Encoder, Hello, Message, Telemetry, CRC32C, MAX_WIRE_LEN,
+};
+use margemu_protocol::PROTOCOL_VERSION;
 use margemu_tests::drive::{self, Samples, Script};
 use margemu_tests::model_source::ModelStream;
-use margemu_tests::qemu::{self, Qemu};
+use margemu_tests::qemu::{self, LinkDecoder, Qemu};
 use margemu_tests::served::ServedTap;
 use margemu_tests::{motion_scene, served::Check};
+use serialport::SerialPort;
 
 struct Options {
     seconds: f64,
@@ -79,6 +88,10 @@ struct Row {
     jitter: Option<(i64, i64, i64)>,
     wall: Duration,
     error: Option<String>,
+    /// The device's last Telemetry.
+    telemetry: Option<Telemetry>,
+    /// QEMU's host CPU time over the run, as a fraction of one core.
+    qemu_cpu: f64,
 }
 
 impl Row {
@@ -92,21 +105,28 @@ impl Row {
             )
         });
         let sustained = self.error.is_none() && self.check.all_exact() && self.underruns == 0;
+        let rx_errors = self.telemetry.map_or("-".into(), |t| {
+            format!("{} / {}", t.crc_errors, t.framing_errors)
+        });
         println!(
-            "| {} | {} | {:.1} | {} of {} | {} | {} | {} | {:.1} | {}{} |",
+            "| {} | {} | {:.1} | {} of {} | {} | {} | {} | {} | {:.0} % | {:.1} | {}{} |",
             self.mode,
             self.rate,
             self.link_bytes_per_s / 1e3,
             self.check.exact,
             self.check.expected,
             self.underruns,
+            rx_errors,
             self.stalls,
             jitter,
+            self.qemu_cpu * 100.0,
             self.wall.as_secs_f64(),
             if sustained { "yes" } else { "no" },
-            self.error
-                .as_ref()
-                .map_or(String::new(), |e| format!(": {e}")),
+            match &self.error {
+                Some(e) => format!(": {e}"),
+                None if !sustained => format!(": {}", self.check.summary()),
+                None => String::new(),
+            },
         );
     }
 }
@@ -128,11 +148,16 @@ fn images(elf: &Path, rate: u32, o: &Options) -> Row {
         .collect();
     let t = Instant::now();
     let (qemu, uart0) = Qemu::boot(elf).expect("boot QEMU");
-    let port = uart0.into_port();
+    let mut port = uart0.into_port();
     let tap = ServedTap::new(port.try_clone_native().expect("clone the PTY"));
     let log = tap.log();
+    // As in tests/tests/qemu_stream.rs: the PTY may stay full longer than 50 ms under QEMU.
+    port.set_timeout(Duration::from_secs(2))
+        .expect("write timeout");
+    let cpu0 = qemu.cpu_time().unwrap_or_default();
     let result = session.run(tap, port, |_| {});
     let wall = t.elapsed();
+    let qemu_cpu = cpu_share(&qemu, cpu0, t);
     drop(qemu);
     let _ = std::fs::remove_dir_all(&dir);
     let check = log.lock().expect("log").0.check(&predicted);
@@ -148,6 +173,8 @@ fn images(elf: &Path, rate: u32, o: &Options) -> Row {
             check,
             wall,
             error: None,
+            telemetry: s.telemetry,
+            qemu_cpu,
         },
         Err(e) => Row {
             mode: "images (a)",
@@ -159,6 +186,8 @@ fn images(elf: &Path, rate: u32, o: &Options) -> Row {
             check,
             wall,
             error: Some(e.to_string()),
+            telemetry: None,
+            qemu_cpu,
         },
     }
 }
@@ -178,8 +207,10 @@ fn model(elf: &Path, rate: u32, o: &Options) -> Row {
     };
     let t = Instant::now();
     let (qemu, uart0) = Qemu::boot(elf).expect("boot QEMU");
+    let cpu0 = qemu.cpu_time().unwrap_or_default();
     let result = drive::run(uart0.into_port(), &script);
     let wall = t.elapsed();
+    let qemu_cpu = cpu_share(&qemu, cpu0, t);
     drop(qemu);
     match result {
         Ok(r) => {
@@ -197,6 +228,8 @@ fn model(elf: &Path, rate: u32, o: &Options) -> Row {
                 check,
                 wall,
                 error: (!r.errors.is_empty()).then(|| format!("device errors {:?}", r.errors)),
+                telemetry: r.telemetry,
+                qemu_cpu,
             }
         }
         Err(e) => Row {
@@ -209,8 +242,63 @@ fn model(elf: &Path, rate: u32, o: &Options) -> Row {
             check: Check::default(),
             wall,
             error: Some(e.to_string()),
+            telemetry: None,
+            qemu_cpu,
         },
     }
+}
+
+/// Garbage bytes in front of the Hello of the receive-path measurement.
+const GARBAGE: usize = 60_000;
+
+/// Writes [`GARBAGE`] bytes and a Hello to a freshly booted board and times the HelloAck:
+/// (bytes per second, QEMU CPU µs per byte).
+fn rx_throughput(elf: &Path) -> Result<(f64, f64), String> {
+    let (qemu, mut uart0) = Qemu::boot(elf).map_err(|e| format!("boot: {e}"))?;
+    let mut decoder = LinkDecoder::default();
+    let mut acks = 0;
+    let mut wait_for = |uart0: &mut qemu::SerialLink, frames: usize| -> Result<(), String> {
+        let deadline = Instant::now() + Duration::from_secs(30);
+        while acks < frames {
+            let left = deadline.saturating_duration_since(Instant::now());
+            let bytes = uart0.read_exact(1, left).map_err(|e| e.to_string())?;
+            decoder.feed(&bytes, &mut |m: &Message<'_>| {
+                if matches!(m, Message::Reset(_) | Message::HelloAck(_)) {
+                    acks += 1;
+                }
+            });
+        }
+        Ok(())
+    };
+    wait_for(&mut uart0, 1)?; // the power-on Reset
+    let mut data = vec![0x01u8; GARBAGE];
+    let mut wire = [0u8; MAX_WIRE_LEN];
+    let hello = Hello {
+        protocol_version: PROTOCOL_VERSION,
+        session: 1,
+    };
+    let n = Encoder::new()
+        .encode(&Message::Hello(hello), &mut wire)
+        .map_err(|e| format!("{e:?}"))?;
+    data.extend_from_slice(&wire[..n]);
+    let port = uart0.port_mut();
+    port.set_timeout(Duration::from_secs(10))
+        .map_err(|e| e.to_string())?;
+    let cpu0 = qemu.cpu_time().map_err(|e| e.to_string())?;
+    let t = Instant::now();
+    port.write_all(&data).map_err(|e| e.to_string())?;
+    port.set_timeout(Duration::from_millis(50))
+        .map_err(|e| e.to_string())?;
+    wait_for(&mut uart0, 2)?;
+    let elapsed = t.elapsed().as_secs_f64();
+    let cpu = (qemu.cpu_time().map_err(|e| e.to_string())? - cpu0).as_secs_f64();
+    Ok((data.len() as f64 / elapsed, cpu / data.len() as f64 * 1e6))
+}
+
+/// QEMU's CPU time since `cpu0` (read at `since`), per second of wall time.
+fn cpu_share(qemu: &Qemu, cpu0: Duration, since: Instant) -> f64 {
+    let cpu = qemu.cpu_time().unwrap_or_default().saturating_sub(cpu0);
+    cpu.as_secs_f64() / since.elapsed().as_secs_f64()
 }
 
 fn loadavg() -> String {
@@ -233,11 +321,21 @@ fn main() {
         o.truth_hz,
         loadavg()
     );
+    println!("\nUART0 receive path: {GARBAGE} bytes + Hello → HelloAck");
+    for run in 1..=3 {
+        match rx_throughput(&elf) {
+            Ok((rate, cpu)) => println!(
+                "  run {run}: {:.1} KB/s, QEMU host CPU {cpu:.1} µs per byte",
+                rate / 1e3
+            ),
+            Err(e) => println!("  run {run}: failed: {e}"),
+        }
+    }
     println!(
-        "\n| mode | rate (Hz) | link to device (KB/s) | byte-exact | underruns | credit stalls | \
-         pacing late p50 / p99 / max (µs) | wall (s) | sustained |"
+        "\n| mode | rate (Hz) | link to device (KB/s) | byte-exact | underruns | device CRC / framing errors | credit stalls | \
+         pacing late p50 / p99 / max (µs) | QEMU CPU | wall (s) | sustained |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for &rate in &o.images {
         images(&elf, rate, &o).print();
     }

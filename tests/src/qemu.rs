@@ -325,6 +325,27 @@ impl Qemu {
         }
     }
 
+    /// Host CPU time QEMU has used so far (all its threads: vCPU, I/O, main loop), from
+    /// `/proc/<pid>/stat` (Linux).
+    pub fn cpu_time(&self) -> io::Result<Duration> {
+        let stat = std::fs::read_to_string(format!("/proc/{}/stat", self.child.id()))?;
+        // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+        let fields: Vec<&str> = stat
+            .rsplit_once(')')
+            .map_or("", |(_, rest)| rest)
+            .split_whitespace()
+            .collect();
+        let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<u64>().ok());
+        let (Some(user), Some(system)) = (ticks(11), ticks(12)) else {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("/proc stat: {stat}"),
+            ));
+        };
+        // USER_HZ is 100 on every Linux this runs on (x86-64, arm64).
+        Ok(Duration::from_millis((user + system) * 10))
+    }
+
     /// Everything QEMU printed so far on stdout and stderr (monitor, semihosting, errors).
     pub fn output(&self) -> String {
         let output = self.output.lock().unwrap_or_else(|e| e.into_inner());

@@ -4,11 +4,11 @@
 //! main loop and the handlers never block each other.
 //!
 //! - **RX.** [`on_rx_interrupt`] acknowledges the interrupt, then moves the received byte into
-//!   the RX ring. A byte that finds the ring full is dropped and counted ([`rx_dropped`]); the
+//!   the RX ring. A byte that finds the ring full is dropped and counted (`RX_DROPPED`); the
 //!   link's CRC then rejects the frame it belonged to.
 //! - **TX.** [`Serial::send`] queues a frame only if all of it fits (a frame cut short is worse
 //!   than one left out: the host counts a lost frame by its sequence number), counts it in
-//!   [`tx_dropped`] otherwise, and pends the TX interrupt. [`on_tx_interrupt`] writes bytes while
+//!   `TX_DROPPED` otherwise, and pends the TX interrupt. [`on_tx_interrupt`] writes bytes while
 //!   the UART takes them. The main loop never waits for the line, so a host that stops reading
 //!   cannot stall the serving of samples.
 
@@ -22,7 +22,7 @@ use heapless::spsc::{Consumer, Producer, Queue};
 use crate::irq::Irq;
 use crate::uart::{Uart, UART0_BASE};
 
-/// RX ring size (one slot stays empty): ~90 ms of the fastest RX QEMU delivers.
+/// RX ring size (one slot stays empty): ~100 ms of the fastest RX QEMU delivers.
 pub const RX_RING: usize = 4096;
 /// TX ring size (one slot stays empty): a few of the largest frames.
 pub const TX_RING: usize = 8192;
@@ -32,7 +32,10 @@ const UART0: Uart = unsafe { Uart::new(UART0_BASE) };
 
 static RX_PRODUCER: Mutex<RefCell<Option<Producer<'static, u8>>>> = Mutex::new(RefCell::new(None));
 static TX_CONSUMER: Mutex<RefCell<Option<Consumer<'static, u8>>>> = Mutex::new(RefCell::new(None));
+/// Received bytes dropped because the RX ring was full, since boot (for a debugger:
+/// `print margemu_board_qemu_mps2_an386::serial::RX_DROPPED`).
 static RX_DROPPED: AtomicU32 = AtomicU32::new(0);
+/// Frames dropped because the TX ring had no room for them, since boot (as `RX_DROPPED`).
 static TX_DROPPED: AtomicU32 = AtomicU32::new(0);
 
 /// The main loop's ends of the two rings.
@@ -88,18 +91,6 @@ impl Serial {
         }
         NVIC::pend(Irq::Uart0Tx);
     }
-}
-
-/// Received bytes dropped because the RX ring was full, since boot.
-#[allow(dead_code)] // read with a debugger (`print margemu_board_qemu_mps2_an386::serial::RX_DROPPED`)
-pub fn rx_dropped() -> u32 {
-    RX_DROPPED.load(Ordering::Relaxed)
-}
-
-/// Frames dropped because the TX ring had no room for them, since boot.
-#[allow(dead_code)] // as `rx_dropped`
-pub fn tx_dropped() -> u32 {
-    TX_DROPPED.load(Ordering::Relaxed)
 }
 
 /// UART0 RX interrupt: the received byte into the RX ring.
