@@ -5,9 +5,10 @@
 //! the address byte. A microcontroller in SPI target mode without a FIFO must have that byte in
 //! its TX register before the first SCK edge of the data byte, but learns the address only at the
 //! last edge of the address byte: half an SCK period later (mode 3, bytes back to back) is all
-//! the time there is, 500 ns at 1 MHz and 25 ns at 20 MHz. The chip model ([`SpiTarget`]) cannot
-//! run in that window, and the board's interrupt handler cannot share the chip with the main
-//! loop's link handler without a lock the bus may not wait for.
+//! the time there is, 500 ns at 1 MHz and 25 ns at 20 MHz. The chip model
+//! ([`SpiTarget`](crate::chip::SpiTarget)) cannot run in that window, and the board's interrupt
+//! handler cannot share the chip with the main loop's link handler without a lock the bus may
+//! not wait for.
 //!
 //! **The design.** The main loop, which owns the chip, keeps a [`Shadow`]: every register as a
 //! bus read would see it ([`Mpu9250::peek`]), and the MISO stream of the burst read the

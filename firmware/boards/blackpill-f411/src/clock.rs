@@ -1,4 +1,4 @@
-//! Monotonic time base: TIM5, a 32-bit up-counter (RM0383 section 13), free-running at 8 MHz
+//! Monotonic time base: TIM5, a 32-bit general-purpose up-counter, free-running at 8 MHz
 //! (125 ns a tick) and extended to 64-bit nanoseconds by polling.
 //!
 //! The counter wraps every 2³² ticks (536.9 s at 8 MHz); [`Clock::now_ns`] adds the ticks since

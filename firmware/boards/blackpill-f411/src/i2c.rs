@@ -1,6 +1,6 @@
 //! I2C1 as the MPU-9250's I2C target, through the PAC (the HAL has no target mode): own address
 //! 0x68 (0x69 with AD0 high), and 0x0C for the AK8963 while the chip is in bypass mode (dual
-//! addressing, OAR2), clock stretching on (RM0383 section 18).
+//! addressing, OAR2), clock stretching on (RM0383, I2C chapter).
 //!
 //! | pin | function (AF4, open drain) |
 //! |-----|----------------------------|
@@ -13,9 +13,9 @@
 //!
 //! Reads are fetched only when the controller asks for the byte: the first at the address
 //! match, each next one at BTF (the previous byte was acknowledged and the data register is
-//! empty; RM0383 figure 164, EV3), with the buffer interrupt off, so a read never pops a FIFO
-//! byte the controller does not take. A NACK (AF) ends a read (STOPF is not set after a NACK,
-//! RM0383 section 18.6.6). Writes are taken at RXNE.
+//! empty: EV3 of RM0383's slave transmitter sequence), with the buffer interrupt off, so a read
+//! never pops a FIFO byte the controller does not take. A NACK (AF) ends a read (STOPF is not
+//! set after a NACK: RM0383, I2C_SR1). Writes are taken at RXNE.
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
@@ -57,8 +57,9 @@ pub fn init(_i2c: I2C1, rcc: &mut Rcc, pclk1_hz: u32) {
     i2c.oar1()
         .write(|w| unsafe { w.bits(OAR1_KEEP | u16::from(0x68u8) << 1) });
     i2c.cr1().write(|w| unsafe { w.bits(CR1_PE) });
-    i2c.cr1().write(|w| unsafe { w.bits(CR1_PE | CR1_ACK) }); // ACK only sticks with PE set
-                                                              // SAFETY: the handlers only use the device once it is installed; priorities before unmasking.
+    // ACK only sticks once PE is set.
+    i2c.cr1().write(|w| unsafe { w.bits(CR1_PE | CR1_ACK) });
+    // SAFETY: the handlers only use the device once it is installed; priorities before unmasking.
     unsafe {
         let mut nvic = cortex_m::Peripherals::steal().NVIC;
         nvic.set_priority(Interrupt::I2C1_EV, PRIORITY);

@@ -47,7 +47,7 @@ const SYSCLK_HZ: u32 = 96_000_000;
 const PCLK1_HZ: u32 = 48_000_000;
 /// Most received bytes fed to the device in one go.
 const RX_CHUNK: usize = 256;
-/// RM0383 section 24.1: the 96-bit unique device ID.
+/// RM0383, "Unique device ID register (96 bits)".
 const UID_ADDRESS: usize = 0x1FFF_7A10;
 const UID_LEN: usize = 12;
 
@@ -162,7 +162,7 @@ fn main() -> ! {
     }
 }
 
-/// Why the MCU booted (RCC_CSR, RM0383 section 6.3.21), then clears the flags. The pin flag is
+/// Why the MCU booted (RCC_CSR reset flags), then clears the flags. The pin flag is
 /// set by every reset, so it counts only when no other is.
 fn reset_cause(rcc: &pac::RCC) -> ResetCause {
     let csr = rcc.csr().read();

@@ -10,10 +10,11 @@
 //! | PA7 | SPI1_MOSI |
 //!
 //! While NSS is high, DMA2 stream 3 (channel 3, SPI1_TX) is armed over the MISO stream of the
-//! armed [`Shadow`] and DMA2 stream 0 (channel 3, SPI1_RX) over [`RX`] (RM0383 table 28). NSS
-//! falling raises EXTI4 at the highest priority; its handler runs [`serve`] until NSS rises,
-//! then resets SPI1 (the only way to empty its TX buffer, RM0383 section 20.3), re-arms both
-//! streams over the front shadow, and queues the [`Capture`] for the main loop.
+//! armed [`Shadow`] and DMA2 stream 0 (channel 3, SPI1_RX) over an [`RX`] buffer (RM0383, DMA2
+//! request mapping). NSS falling raises EXTI4 at the highest priority; its handler runs
+//! [`serve`] until NSS rises, then (in `Port::end`) resets SPI1 (the only way to empty its TX
+//! buffer), re-arms both streams over the front shadow and the other RX buffer, and queues the
+//! [`Capture`] for the main loop.
 //!
 //! **Sharing.** Two shadows: the main loop rewrites only the back one, and only once the handler
 //! has re-armed away from it ([`SpiTarget::back`]); [`SpiTarget::publish`] makes it the front and
@@ -35,7 +36,7 @@ const TX_STREAM: usize = 3;
 /// DMA2 stream carrying MOSI bytes from SPI1_DR to [`RX`].
 const RX_STREAM: usize = 0;
 
-/// SxCR (RM0383 section 9.5.5): CHSEL = 3 (SPI1), PL = very high, MINC, 8-bit sizes.
+/// DMA_SxCR (RM0383, DMA chapter): CHSEL = 3 (SPI1), PL = very high, MINC, 8-bit sizes.
 const DMA_CR_COMMON: u32 = (3 << 25) | (3 << 16) | (1 << 10);
 const DMA_CR_MEM_TO_PERIPH: u32 = 1 << 6;
 const DMA_CR_EN: u32 = 1 << 0;
@@ -225,7 +226,7 @@ fn arm(front: usize) {
     tx.fcr().write(|w| unsafe { w.bits(0) }); // direct mode: one byte per request
     tx.cr()
         .write(|w| unsafe { w.bits(DMA_CR_COMMON | DMA_CR_MEM_TO_PERIPH | DMA_CR_EN) });
-    // RM0383 section 20.3.9: RXDMAEN, streams, TXDMAEN, then SPE.
+    // RM0383, SPI communication using DMA: RXDMAEN, streams, TXDMAEN, then SPE.
     spi.cr2()
         .write(|w| unsafe { w.bits(SPI_CR2_RXDMAEN | SPI_CR2_TXDMAEN) });
     spi.cr1()
