@@ -2,6 +2,10 @@
 //! paper-like scene of the tests (200 Hz, the paper's noise, ±50 rad/s oscillations, ±4 g
 //! external accelerations, magnetic bursts), replayed in a loop.
 //!
+//! The baseline is the `ahrs` crate's Madgwick filter (MARG update, nalgebra), a plain Rust
+//! implementation of the same algorithm family, timed in the same run so that ratios hold on a
+//! shared machine.
+//!
 //! `cargo bench -p margemu-filters -- --warm-up-time 1 --measurement-time 3`
 
 // criterion_group! generates an undocumented public function.
@@ -12,9 +16,7 @@ mod common;
 
 use common::{widen, Scene};
 use criterion::{criterion_group, criterion_main, Criterion};
-use margemu_filters::{
-    AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, Imu, Real,
-};
+use margemu_filters::{AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, Imu, Real};
 use std::hint::black_box;
 
 const SAMPLES: usize = 4096;
@@ -22,10 +24,18 @@ const SAMPLES: usize = 4096;
 fn samples() -> Vec<Imu<f32>> {
     let mut scene = Scene::new(200.0, 3);
     // Skip the first seconds so that bursts and accelerations are under way.
-    (0..2000 + SAMPLES).map(|_| scene.next().1).skip(2000).collect()
+    (0..2000 + SAMPLES)
+        .map(|_| scene.next().1)
+        .skip(2000)
+        .collect()
 }
 
-fn bench_filter<T: Real, F: AttitudeFilter<T>>(c: &mut Criterion, name: &str, mut f: F, input: &[Imu<T>]) {
+fn bench_filter<T: Real, F: AttitudeFilter<T>>(
+    c: &mut Criterion,
+    name: &str,
+    mut f: F,
+    input: &[Imu<T>],
+) {
     let dt = T::from_f64(0.005);
     for imu in input {
         f.update(imu, dt);
@@ -40,15 +50,70 @@ fn bench_filter<T: Real, F: AttitudeFilter<T>>(c: &mut Criterion, name: &str, mu
     });
 }
 
+/// The `ahrs` crate's Madgwick MARG update over the same samples.
+macro_rules! baseline {
+    ($c:expr, $t:ty, $name:expr, $input:expr) => {{
+        use ahrs::{Ahrs, Madgwick};
+        use nalgebra_for_ahrs::Vector3;
+        let v = |a: [$t; 3]| Vector3::new(a[0], a[1], a[2]);
+        let input: Vec<[Vector3<$t>; 3]> = $input
+            .iter()
+            .map(|i| [v(i.gyro), v(i.acc), v(i.mag)])
+            .collect();
+        let mut f = Madgwick::<$t>::new(0.005, 0.1);
+        let mut k = 0;
+        $c.bench_function($name, |b| {
+            b.iter(|| {
+                let [g, a, m] = black_box(&input[k]);
+                let q = f.update(g, a, m).map(|q| *q);
+                k = (k + 1) % SAMPLES;
+                black_box(q)
+            })
+        });
+    }};
+}
+
 fn bench(c: &mut Criterion) {
     let single = samples();
     let double: Vec<Imu<f64>> = single.iter().map(widen).collect();
-    bench_filter(c, "ecf_f32", Ecf::<f32>::new(&EcfConfig::default()).unwrap(), &single);
-    bench_filter(c, "ecf_f64", Ecf::<f64>::new(&EcfConfig::default()).unwrap(), &double);
-    bench_filter(c, "gda_f32", Gda::<f32>::new(&GdaConfig::default()).unwrap(), &single);
-    bench_filter(c, "gda_f64", Gda::<f64>::new(&GdaConfig::default()).unwrap(), &double);
-    bench_filter(c, "ekf_f32", Ekf::<f32>::new(&EkfConfig::default()).unwrap(), &single);
-    bench_filter(c, "ekf_f64", Ekf::<f64>::new(&EkfConfig::default()).unwrap(), &double);
+    baseline!(c, f32, "baseline_ahrs_madgwick_f32", single);
+    baseline!(c, f64, "baseline_ahrs_madgwick_f64", double);
+    bench_filter(
+        c,
+        "ecf_f32",
+        Ecf::<f32>::new(&EcfConfig::default()).unwrap(),
+        &single,
+    );
+    bench_filter(
+        c,
+        "ecf_f64",
+        Ecf::<f64>::new(&EcfConfig::default()).unwrap(),
+        &double,
+    );
+    bench_filter(
+        c,
+        "gda_f32",
+        Gda::<f32>::new(&GdaConfig::default()).unwrap(),
+        &single,
+    );
+    bench_filter(
+        c,
+        "gda_f64",
+        Gda::<f64>::new(&GdaConfig::default()).unwrap(),
+        &double,
+    );
+    bench_filter(
+        c,
+        "ekf_f32",
+        Ekf::<f32>::new(&EkfConfig::default()).unwrap(),
+        &single,
+    );
+    bench_filter(
+        c,
+        "ekf_f64",
+        Ekf::<f64>::new(&EkfConfig::default()).unwrap(),
+        &double,
+    );
 }
 
 criterion_group!(benches, bench);

@@ -37,7 +37,7 @@
 
 use crate::filter::{AttitudeFilter, Diagnostics, Imu};
 use crate::init::{parameter, Initial, Shared, DEFAULT_MAG_REFERENCE};
-use crate::quat::{cross, integrate, up_in_body, world_to_body, Quat, Vec3};
+use crate::quat::{axpy, cross, integrate, up_in_body, world_to_body, Quat, Vec3};
 use crate::{Error, Real};
 
 /// Parameters of the [`Ecf`].
@@ -99,15 +99,13 @@ impl<T: Real> AttitudeFilter<T> for Ecf<T> {
         let q = self.s.q;
         let mut e = [T::ZERO; 3];
         if let Some(a) = step.acc {
-            let c = cross(a, up_in_body(q));
-            e = [e[0] + c[0], e[1] + c[1], e[2] + c[2]];
+            e = cross(a, up_in_body(q));
         }
         if let Some(h) = step.mag {
-            let c = cross(h, world_to_body(q, self.s.mag_ref));
-            e = [e[0] + c[0], e[1] + c[1], e[2] + c[2]];
+            e = axpy(e, T::ONE, cross(h, world_to_body(q, self.s.mag_ref)));
         }
-        let integral = [0, 1, 2].map(|i| self.integral[i] + e[i] * step.dt);
-        let omega = [0, 1, 2].map(|i| step.gyro[i] + self.kp * e[i] + self.ki * integral[i]);
+        let integral = axpy(self.integral, step.dt, e);
+        let omega = axpy(axpy(step.gyro, self.kp, e), self.ki, integral);
         let finite = integral.iter().all(|c| c.is_finite());
         if finite && self.s.commit(integrate(q, omega, step.dt)) {
             self.integral = integral;

@@ -49,7 +49,10 @@ impl fmt::Display for Error {
         match self {
             Error::NonFiniteParameter { what } => write!(f, "parameter `{what}` must be finite"),
             Error::ParameterTooLarge { what } => {
-                write!(f, "parameter `{what}` is beyond the range of the filter's float type")
+                write!(
+                    f,
+                    "parameter `{what}` is beyond the range of the filter's float type"
+                )
             }
             Error::NegativeParameter { what } => {
                 write!(f, "parameter `{what}` must not be negative")

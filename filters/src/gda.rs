@@ -46,7 +46,9 @@
 
 use crate::filter::{AttitudeFilter, Diagnostics, Imu};
 use crate::init::{parameter, Initial, Shared, DEFAULT_MAG_REFERENCE};
-use crate::quat::{cross, mul, normalize, up_in_body, world_to_body, Quat, Vec3};
+use crate::quat::{
+    axpy, cross, dot3, mul, normalize, scale, up_in_body, world_to_body, Quat, Vec3,
+};
 use crate::{Error, Real};
 
 /// What the gradient step of eq. 25 is divided by.
@@ -102,10 +104,9 @@ fn residual_terms<T: Real>(
     let mut sigma = T::ZERO;
     let mut e = [T::ZERO; 3];
     let mut add = |measured: Vec3<T>, predicted: Vec3<T>| {
-        let c = cross(measured, predicted);
-        let d = [0, 1, 2].map(|i| predicted[i] - measured[i]);
-        sigma += T::HALF * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        e = [e[0] + c[0], e[1] + c[1], e[2] + c[2]];
+        let d = axpy(predicted, -T::ONE, measured);
+        sigma += T::HALF * dot3(d, d);
+        e = axpy(e, T::ONE, cross(measured, predicted));
     };
     if let Some(a) = acc {
         add(a, up_in_body(q));
@@ -126,7 +127,7 @@ pub fn objective_gradient<T: Real>(
     mag_reference: Vec3<T>,
 ) -> Quat<T> {
     let (sigma, e) = residual_terms(q, normalize(acc), normalize(mag), mag_reference);
-    mul(q, [sigma, -e[0], -e[1], -e[2]]).map(|c| c + c)
+    scale(mul(q, [sigma, -e[0], -e[1], -e[2]]), T::TWO)
 }
 
 impl<T: Real> Gda<T> {
@@ -148,11 +149,17 @@ impl<T: Real> AttitudeFilter<T> for Gda<T> {
         let q = self.s.q;
         let (sigma, e) = residual_terms(q, step.acc, step.mag, self.s.mag_ref);
         let norm = match self.normalization {
-            GdaNormalization::Gradient => (sigma * sigma + e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt(),
+            GdaNormalization::Gradient => {
+                (sigma * sigma + e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
+            }
             GdaNormalization::Residual => (T::TWO * sigma).sqrt() * T::HALF,
         };
         // β' of the module docs; no correction at an exact optimum (0/0).
-        let gain = if norm > T::ZERO { self.beta / norm } else { T::ZERO };
+        let gain = if norm > T::ZERO {
+            self.beta / norm
+        } else {
+            T::ZERO
+        };
         let p = [
             -gain * sigma,
             T::HALF * step.gyro[0] + gain * e[0],
@@ -160,7 +167,7 @@ impl<T: Real> AttitudeFilter<T> for Gda<T> {
             T::HALF * step.gyro[2] + gain * e[2],
         ];
         let d = mul(q, p);
-        self.s.commit([0, 1, 2, 3].map(|i| q[i] + step.dt * d[i]));
+        self.s.commit(axpy(q, step.dt, d));
     }
 
     fn quaternion(&self) -> Quat<T> {

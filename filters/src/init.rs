@@ -73,7 +73,11 @@ pub fn triad<T: Real>(acc: Vec3<T>, mag: Vec3<T>, mag_reference: Vec3<T>) -> Opt
 }
 
 /// `value` as `T`, checked: finite, in range, and `>= 0` (or `> 0` when `positive`).
-pub(crate) fn parameter<T: Real>(value: f64, what: &'static str, positive: bool) -> Result<T, Error> {
+pub(crate) fn parameter<T: Real>(
+    value: f64,
+    what: &'static str,
+    positive: bool,
+) -> Result<T, Error> {
     if !value.is_finite() {
         return Err(Error::NonFiniteParameter { what });
     }
@@ -112,7 +116,9 @@ pub(crate) struct Shared<T> {
 impl<T: Real> Shared<T> {
     pub fn new(mag_reference: [f64; 3], initial: Initial) -> Result<Self, Error> {
         if mag_reference.iter().any(|c| !c.is_finite()) {
-            return Err(Error::NonFiniteParameter { what: "mag_reference" });
+            return Err(Error::NonFiniteParameter {
+                what: "mag_reference",
+            });
         }
         let m = normalize(mag_reference).ok_or(Error::ZeroMagneticReference)?;
         if (m[0] * m[0] + m[1] * m[1]).sqrt() < 1e-3 {

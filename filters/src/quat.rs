@@ -50,6 +50,26 @@ pub fn mul_pure<T: Real>(q: Quat<T>, v: Vec3<T>) -> Quat<T> {
     ]
 }
 
+/// `a + s·b`, element by element (also `a + b` with `s = 1`).
+#[inline(always)]
+pub fn axpy<T: Real, const N: usize>(a: [T; N], s: T, b: [T; N]) -> [T; N] {
+    let mut out = a;
+    for i in 0..N {
+        out[i] = a[i] + s * b[i];
+    }
+    out
+}
+
+/// `s·v`.
+#[inline(always)]
+pub fn scale<T: Real, const N: usize>(v: [T; N], s: T) -> [T; N] {
+    let mut out = v;
+    for c in &mut out {
+        *c = *c * s;
+    }
+    out
+}
+
 /// `a · b`.
 #[inline(always)]
 pub fn dot3<T: Real>(a: Vec3<T>, b: Vec3<T>) -> T {
@@ -77,8 +97,7 @@ pub fn normalize<T: Real, const N: usize>(v: [T; N]) -> Option<[T; N]> {
         n2 += c * c;
     }
     if n2.is_finite() && n2 >= T::MIN_POSITIVE {
-        let inv = T::ONE / n2.sqrt();
-        Some(v.map(|c| c * inv))
+        Some(scale(v, T::ONE / n2.sqrt()))
     } else {
         normalize_scaled(v)
     }
@@ -113,7 +132,7 @@ fn normalize_scaled<T: Real, const N: usize>(v: [T; N]) -> Option<[T; N]> {
 pub fn world_to_body<T: Real>(q: Quat<T>, r: Vec3<T>) -> Vec3<T> {
     // v = r − w·t + u × t with t = 2·(u × r), u the vector part (rotation by q*).
     let u = [q[1], q[2], q[3]];
-    let t = cross(u, r).map(|c| c + c);
+    let t = scale(cross(u, r), T::TWO);
     let ut = cross(u, t);
     [
         r[0] - q[0] * t[0] + ut[0],
@@ -143,14 +162,7 @@ pub fn up_in_body<T: Real>(q: Quat<T>) -> Vec3<T> {
 /// not normalized.
 #[inline(always)]
 pub fn integrate<T: Real>(q: Quat<T>, omega: Vec3<T>, dt: T) -> Quat<T> {
-    let h = T::HALF * dt;
-    let d = mul_pure(q, omega);
-    [
-        q[0] + h * d[0],
-        q[1] + h * d[1],
-        q[2] + h * d[2],
-        q[3] + h * d[3],
-    ]
+    axpy(q, T::HALF * dt, mul_pure(q, omega))
 }
 
 /// The angle (rad, in [0, π]) of the rotation between two attitudes; `q` and `−q` are equal.
@@ -303,7 +315,8 @@ mod tests {
             [1.6, 1.5, -1.2],
         ] {
             let q = from_euler_zyx::<f64>(e);
-            let cols = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|v| body_to_world(q, v));
+            let cols =
+                [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|v| body_to_world(q, v));
             let m = [0, 1, 2].map(|r| [cols[0][r], cols[1][r], cols[2][r]]);
             assert!(geodesic_angle(q, from_rotation_matrix(m)) < 1e-14, "{e:?}");
         }

@@ -117,5 +117,21 @@ macro_rules! impl_real {
     };
 }
 
-impl_real!(f32, libm::sqrtf, libm::fabsf, libm::atan2f, libm::sinf, libm::cosf, libm::floorf);
-impl_real!(f64, libm::sqrt, libm::fabs, libm::atan2, libm::sin, libm::cos, libm::floor);
+impl_real!(
+    f32,
+    libm::sqrtf,
+    libm::fabsf,
+    libm::atan2f,
+    libm::sinf,
+    libm::cosf,
+    libm::floorf
+);
+impl_real!(
+    f64,
+    libm::sqrt,
+    libm::fabs,
+    libm::atan2,
+    libm::sin,
+    libm::cos,
+    libm::floor
+);

@@ -30,8 +30,17 @@ fn ekf_config(initial: Initial) -> EkfConfig {
 /// loop is faster with a larger bias walk (the default of 1e-4 takes minutes to forget the bias
 /// transient of a 60° start).
 fn filters<T: Real>(initial: Initial) -> Vec<(&'static str, Box<dyn AttitudeFilter<T>>)> {
-    let ecf = EcfConfig { kp: 5.0, ki: 2.0, initial, ..EcfConfig::default() };
-    let gda = GdaConfig { beta: BETA, initial, ..GdaConfig::default() };
+    let ecf = EcfConfig {
+        kp: 5.0,
+        ki: 2.0,
+        initial,
+        ..EcfConfig::default()
+    };
+    let gda = GdaConfig {
+        beta: BETA,
+        initial,
+        ..GdaConfig::default()
+    };
     let ekf = ekf_config(initial);
     vec![
         ("ecf", Box::new(Ecf::new(&ecf).unwrap())),
@@ -49,7 +58,10 @@ fn final_errors<T: Real>(seconds: f64) -> Vec<(&'static str, f64)> {
         let truth = from_euler_zyx(e);
         let start = turned(truth, axis, 60f64.to_radians());
         let imu = static_imu::<T>(truth, [0.0; 3]);
-        for (i, (name, mut f)) in filters::<T>(Initial::Attitude(start)).into_iter().enumerate() {
+        for (i, (name, mut f)) in filters::<T>(Initial::Attitude(start))
+            .into_iter()
+            .enumerate()
+        {
             let steps = (seconds / DT) as usize;
             let mut err = 0.0f64;
             for k in 0..steps {
@@ -73,7 +85,13 @@ fn each_filter_converges_from_60_degrees_off_in_f64() {
     for (name, err) in final_errors::<f64>(60.0) {
         // GDA dithers around the optimum within its step, 2·β·dt (see gda.rs); the others
         // converge exponentially.
-        let bound = if name == "gda" { 2.0 * BETA * DT + 1e-9 } else if name == "ecf" { 1e-8 } else { 1e-12 };
+        let bound = if name == "gda" {
+            2.0 * BETA * DT + 1e-9
+        } else if name == "ecf" {
+            1e-8
+        } else {
+            1e-12
+        };
         assert!(err < bound, "{name}: {err:e} >= {bound:e}");
     }
 }
@@ -81,7 +99,11 @@ fn each_filter_converges_from_60_degrees_off_in_f64() {
 #[test]
 fn each_filter_converges_from_60_degrees_off_in_f32() {
     for (name, err) in final_errors::<f32>(60.0) {
-        let bound = if name == "gda" { 2.0 * BETA * DT + 1e-6 } else { 1e-5 };
+        let bound = if name == "gda" {
+            2.0 * BETA * DT + 1e-6
+        } else {
+            1e-5
+        };
         assert!(err < bound, "{name}: {err:e} >= {bound:e}");
     }
 }
@@ -91,7 +113,11 @@ fn started_from_the_first_sample_each_filter_is_right_at_once() {
     for e in attitudes() {
         let truth = from_euler_zyx(e);
         for (name, mut f) in filters::<f64>(Initial::FirstSample) {
-            assert_eq!(f.quaternion(), [1.0, 0.0, 0.0, 0.0], "{name}: identity until a sample");
+            assert_eq!(
+                f.quaternion(),
+                [1.0, 0.0, 0.0, 0.0],
+                "{name}: identity until a sample"
+            );
             let imu = static_imu(truth, [0.0; 3]);
             f.update(&imu, DT);
             let err = geodesic_angle(f.quaternion(), truth);
@@ -99,7 +125,10 @@ fn started_from_the_first_sample_each_filter_is_right_at_once() {
             let ypr = f.euler();
             let want = euler_zyx(truth);
             for i in 0..3 {
-                assert!((ypr[i] - want[i]).abs() < 1e-9, "{name} {e:?}: {ypr:?} vs {want:?}");
+                assert!(
+                    (ypr[i] - want[i]).abs() < 1e-9,
+                    "{name} {e:?}: {ypr:?} vs {want:?}"
+                );
             }
         }
         for (name, mut f) in filters::<f32>(Initial::FirstSample) {
@@ -136,8 +165,15 @@ fn q_and_minus_q_are_the_same_attitude() {
         b.reset(truth.map(|c| -c));
         a.update(&imu, DT);
         b.update(&imu, DT);
-        assert!(geodesic_angle(a.quaternion(), b.quaternion()) < 1e-15, "{name}");
-        let bound = if name == "gda" { 2.0 * BETA * DT + 1e-9 } else { 1e-12 };
+        assert!(
+            geodesic_angle(a.quaternion(), b.quaternion()) < 1e-15,
+            "{name}"
+        );
+        let bound = if name == "gda" {
+            2.0 * BETA * DT + 1e-9
+        } else {
+            1e-12
+        };
         assert!(geodesic_angle(b.quaternion(), truth) < bound, "{name}");
     }
 }
@@ -149,7 +185,13 @@ fn ecf_integrator_and_ekf_bias_states_remove_a_constant_gyro_bias() {
         let truth = from_euler_zyx(e);
         let imu = static_imu(truth, bias);
         let initial = Initial::Attitude(turned(truth, [1.0, 0.0, 0.0], 0.3));
-        let mut ecf = Ecf::<f64>::new(&EcfConfig { kp: 5.0, ki: 2.0, initial, ..EcfConfig::default() }).unwrap();
+        let mut ecf = Ecf::<f64>::new(&EcfConfig {
+            kp: 5.0,
+            ki: 2.0,
+            initial,
+            ..EcfConfig::default()
+        })
+        .unwrap();
         let mut ekf = Ekf::<f64>::new(&ekf_config(initial)).unwrap();
         for _ in 0..(60.0 / DT) as usize {
             ecf.update(&imu, DT);

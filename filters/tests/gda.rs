@@ -14,7 +14,13 @@ const BETA: f64 = 0.1;
 
 fn gda(normalization: GdaNormalization, start: Quat<f64>) -> Gda<f64> {
     let initial = Initial::Attitude(start);
-    Gda::new(&GdaConfig { beta: BETA, normalization, initial, ..GdaConfig::default() }).unwrap()
+    Gda::new(&GdaConfig {
+        beta: BETA,
+        normalization,
+        initial,
+        ..GdaConfig::default()
+    })
+    .unwrap()
 }
 
 /// `½‖f(q)‖²` with the homogeneous residuals `q* ⊗ r ⊗ q − s` of unit measurements `s`.
@@ -25,7 +31,10 @@ fn objective(q: Quat<f64>, acc: [f64; 3], mag: [f64; 3], m_ref: [f64; 3]) -> f64
     };
     let (a, h) = (normalize(acc).unwrap(), normalize(mag).unwrap());
     let (fa, fh) = (body([0.0, 0.0, 1.0]), body(m_ref));
-    (0..3).map(|i| (fa[i] - a[i]).powi(2) + (fh[i] - h[i]).powi(2)).sum::<f64>() / 2.0
+    (0..3)
+        .map(|i| (fa[i] - a[i]).powi(2) + (fh[i] - h[i]).powi(2))
+        .sum::<f64>()
+        / 2.0
 }
 
 #[test]
@@ -56,7 +65,10 @@ fn first_step(normalization: GdaNormalization) -> f64 {
     let truth = from_euler_zyx([0.2, 0.3, 1.0]);
     let start = turned(truth, [1.0, 0.0, 0.0], 1f64.to_radians());
     let mut f = gda(normalization, start);
-    let imu = Imu { mag: [0.0; 3], ..static_imu(truth, [0.0; 3]) };
+    let imu = Imu {
+        mag: [0.0; 3],
+        ..static_imu(truth, [0.0; 3])
+    };
     f.update(&imu, DT);
     assert_eq!(f.diagnostics().skipped_mag, 1);
     geodesic_angle(f.quaternion(), start)
@@ -66,8 +78,14 @@ fn first_step(normalization: GdaNormalization) -> f64 {
 fn madgwick_normalization_turns_at_2_beta_and_the_printed_one_at_4_beta() {
     let gradient = first_step(GdaNormalization::Gradient);
     let residual = first_step(GdaNormalization::Residual);
-    assert!((gradient / (2.0 * BETA * DT) - 1.0).abs() < 1e-3, "{gradient}");
-    assert!((residual / (4.0 * BETA * DT) - 1.0).abs() < 1e-3, "{residual}");
+    assert!(
+        (gradient / (2.0 * BETA * DT) - 1.0).abs() < 1e-3,
+        "{gradient}"
+    );
+    assert!(
+        (residual / (4.0 * BETA * DT) - 1.0).abs() < 1e-3,
+        "{residual}"
+    );
 }
 
 /// The largest error over the last second of a 60 s static run from 60° off, over all attitudes.
@@ -75,7 +93,10 @@ fn settled_error(normalization: GdaNormalization) -> f64 {
     let mut worst = 0.0f64;
     for e in attitudes() {
         let truth = from_euler_zyx(e);
-        let mut f = gda(normalization, turned(truth, [0.48, -0.6, 0.64], 60f64.to_radians()));
+        let mut f = gda(
+            normalization,
+            turned(truth, [0.48, -0.6, 0.64], 60f64.to_radians()),
+        );
         let imu = static_imu(truth, [0.0; 3]);
         for k in 0..12_000 {
             f.update(&imu, DT);
@@ -94,6 +115,9 @@ fn both_normalizations_converge_and_settle_within_their_step() {
     let gradient = settled_error(GdaNormalization::Gradient);
     assert!(gradient <= 2.0 * BETA * DT + 1e-9, "{gradient}");
     let residual = settled_error(GdaNormalization::Residual);
-    assert!(residual <= 4.0 * 2f64.sqrt() * BETA * DT + 1e-9, "{residual}");
+    assert!(
+        residual <= 4.0 * 2f64.sqrt() * BETA * DT + 1e-9,
+        "{residual}"
+    );
     eprintln!("settled: gradient {gradient:.3e} residual {residual:.3e}");
 }

@@ -45,12 +45,16 @@ impl<T: Real> Bank<T> {
 
     fn update(&mut self, imu: &margemu_filters::Imu<T>, truth: [f64; 4], k: usize) {
         let dt = T::from_f64(1.0 / RATE);
-        let filters: [&mut dyn AttitudeFilter<T>; 3] = [&mut self.ecf, &mut self.gda, &mut self.ekf];
+        let filters: [&mut dyn AttitudeFilter<T>; 3] =
+            [&mut self.ecf, &mut self.gda, &mut self.ekf];
         for (i, f) in filters.into_iter().enumerate() {
             f.update(imu, dt);
             let q = f.quaternion().map(|c| c.to_f64());
             let n2: f64 = q.iter().map(|c| c * c).sum();
-            assert!(q.iter().all(|c| c.is_finite()) && (n2 - 1.0).abs() < 1e-5, "filter {i} at {k}: {q:?}");
+            assert!(
+                q.iter().all(|c| c.is_finite()) && (n2 - 1.0).abs() < 1e-5,
+                "filter {i} at {k}: {q:?}"
+            );
             self.sq_err[i] += geodesic_angle(q, truth).powi(2);
         }
         assert!(self.ekf.bias().iter().all(|c| c.to_f64().is_finite()));
@@ -68,7 +72,10 @@ impl<T: Real> Bank<T> {
             }
         }
         let m = SMatrix::<f64, N, N>::from_fn(|i, j| p[i][j].to_f64());
-        assert!(m.cholesky().is_some(), "P not positive definite at sample {k}: {m}");
+        assert!(
+            m.cholesky().is_some(),
+            "P not positive definite at sample {k}: {m}"
+        );
         let eig = m.symmetric_eigenvalues();
         let (lo, hi) = (eig.min(), eig.max());
         assert!(lo > 0.0, "P eigenvalue {lo} at sample {k}");
@@ -77,8 +84,13 @@ impl<T: Real> Bank<T> {
 }
 
 #[test]
-fn an_hour_of_paper_like_motion_keeps_filters_finite_alike_in_f32_and_f64_and_the_ekf_covariance_positive_definite() {
-    let seconds = if cfg!(debug_assertions) { DEBUG_SECONDS } else { 3600.0 };
+fn an_hour_of_paper_like_motion_keeps_filters_finite_alike_in_f32_and_f64_and_the_ekf_covariance_positive_definite(
+) {
+    let seconds = if cfg!(debug_assertions) {
+        DEBUG_SECONDS
+    } else {
+        3600.0
+    };
     let steps = (seconds * RATE) as usize;
     let mut scene = Scene::new(RATE, 7);
     let mut single = Bank::<f32>::new();
@@ -101,11 +113,20 @@ fn an_hour_of_paper_like_motion_keeps_filters_finite_alike_in_f32_and_f64_and_th
             max_diff[i] = max_diff[i].max(geodesic_angle(a.map(f64::from), b));
         }
     }
-    eprintln!("f32 vs f64: largest angle ECF {:.1e} GDA {:.1e} EKF {:.1e} rad", max_diff[0], max_diff[1], max_diff[2]);
-    assert!(max_diff.iter().all(|&d| d < PRECISION_TOLERANCE), "{max_diff:?}");
+    eprintln!(
+        "f32 vs f64: largest angle ECF {:.1e} GDA {:.1e} EKF {:.1e} rad",
+        max_diff[0], max_diff[1], max_diff[2]
+    );
+    assert!(
+        max_diff.iter().all(|&d| d < PRECISION_TOLERANCE),
+        "{max_diff:?}"
+    );
     // The scene is what it claims: fast oscillations and large magnetic bursts.
     assert!(max_rate > 40.0 && max_mag > 3.0, "{max_rate} {max_mag}");
-    for (name, bank) in [("f32", (single.eig, single.sq_err, single.ekf.diagnostics())), ("f64", (double.eig, double.sq_err, double.ekf.diagnostics()))] {
+    for (name, bank) in [
+        ("f32", (single.eig, single.sq_err, single.ekf.diagnostics())),
+        ("f64", (double.eig, double.sq_err, double.ekf.diagnostics())),
+    ] {
         let (eig, sq, diag) = bank;
         let rms = sq.map(|s| (s / steps as f64).sqrt());
         eprintln!(

@@ -4,8 +4,8 @@
 
 use margemu_filters::quat::Quat;
 use margemu_filters::{
-    AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, GdaNormalization, Imu,
-    Initial, Real,
+    AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, GdaNormalization, Imu, Initial,
+    Real,
 };
 use proptest::prelude::*;
 
@@ -56,7 +56,11 @@ fn initial() -> impl Strategy<Value = Initial> {
 
 fn narrow(imu: &Imu<f64>) -> Imu<f32> {
     let n = |v: [f64; 3]| v.map(|c| c as f32);
-    Imu { gyro: n(imu.gyro), acc: n(imu.acc), mag: n(imu.mag) }
+    Imu {
+        gyro: n(imu.gyro),
+        acc: n(imu.acc),
+        mag: n(imu.mag),
+    }
 }
 
 fn check_unit<T: Real>(q: Quat<T>, what: &str) {
@@ -79,11 +83,28 @@ fn check_ekf<T: Real>(ekf: &Ekf<T>) {
 
 /// Runs all three filters in `T` over `samples`, checking after every call.
 fn run_all<T: Real>(initial: Initial, beta_residual: bool, samples: &[(Imu<T>, T)]) {
-    let normalization =
-        if beta_residual { GdaNormalization::Residual } else { GdaNormalization::Gradient };
-    let mut ecf = Ecf::<T>::new(&EcfConfig { ki: 0.5, initial, ..EcfConfig::default() }).unwrap();
-    let mut gda = Gda::<T>::new(&GdaConfig { normalization, initial, ..GdaConfig::default() }).unwrap();
-    let mut ekf = Ekf::<T>::new(&EkfConfig { initial, ..EkfConfig::default() }).unwrap();
+    let normalization = if beta_residual {
+        GdaNormalization::Residual
+    } else {
+        GdaNormalization::Gradient
+    };
+    let mut ecf = Ecf::<T>::new(&EcfConfig {
+        ki: 0.5,
+        initial,
+        ..EcfConfig::default()
+    })
+    .unwrap();
+    let mut gda = Gda::<T>::new(&GdaConfig {
+        normalization,
+        initial,
+        ..GdaConfig::default()
+    })
+    .unwrap();
+    let mut ekf = Ekf::<T>::new(&EkfConfig {
+        initial,
+        ..EkfConfig::default()
+    })
+    .unwrap();
     for (imu, dt) in samples {
         ecf.update(imu, *dt);
         gda.update(imu, *dt);
@@ -127,20 +148,51 @@ proptest! {
 
 #[test]
 fn degenerate_inputs_are_skipped_and_counted() {
-    let level = Imu { gyro: [0.0; 3], acc: [0.0, 0.0, 9.81], mag: [0.5, 0.0, -0.83] };
+    let level = Imu {
+        gyro: [0.0; 3],
+        acc: [0.0, 0.0, 9.81],
+        mag: [0.5, 0.0, -0.83],
+    };
     let mut f = Ekf::<f64>::new(&EkfConfig::default()).unwrap();
     f.update(&level, 0.005); // initializes
-    f.update(&Imu { acc: [0.0; 3], ..level }, 0.005);
-    f.update(&Imu { mag: [f64::NAN, 0.0, 0.0], ..level }, 0.005);
-    f.update(&Imu { gyro: [f64::INFINITY, 0.0, 0.0], ..level }, 0.005);
+    f.update(
+        &Imu {
+            acc: [0.0; 3],
+            ..level
+        },
+        0.005,
+    );
+    f.update(
+        &Imu {
+            mag: [f64::NAN, 0.0, 0.0],
+            ..level
+        },
+        0.005,
+    );
+    f.update(
+        &Imu {
+            gyro: [f64::INFINITY, 0.0, 0.0],
+            ..level
+        },
+        0.005,
+    );
     f.update(&level, 0.0);
     f.update(&level, -0.005);
     f.update(&level, f64::NAN);
     let d = f.diagnostics();
-    assert_eq!((d.updates, d.skipped_updates, d.skipped_accel, d.skipped_mag), (3, 4, 1, 1));
+    assert_eq!(
+        (d.updates, d.skipped_updates, d.skipped_accel, d.skipped_mag),
+        (3, 4, 1, 1)
+    );
     assert_eq!(d.rejected, 0);
     // A step too long to be finite is undone whole.
-    f.update(&Imu { gyro: [1e300, 1e300, 1e300], ..level }, 1e300);
+    f.update(
+        &Imu {
+            gyro: [1e300, 1e300, 1e300],
+            ..level
+        },
+        1e300,
+    );
     assert_eq!(f.diagnostics().rejected, 1);
     check_unit(f.quaternion(), "after a rejected step");
 }

@@ -13,38 +13,53 @@ pub const N: usize = 7;
 pub type Cov<T> = [[T; N]; N];
 
 /// `Φ·P·Φᵀ + Q` for `Φ = [[A, B], [0, I]]` (`A` 4×4, `B` 4×3) and `Q = diag(qq·I₄, qb·I₃)`.
+///
+/// Row-oriented, so that the inner loops run along rows: `M = [A B]·P` (the first four rows of
+/// `Φ·P`) as sums of scaled rows of `P`, then the attitude block `M·[A B]ᵀ` as sums of scaled rows
+/// of `[A B]ᵀ`, mirrored from its upper triangle.
 #[inline(always)]
 pub fn predict<T: Real>(p: &mut Cov<T>, a: &[[T; 4]; 4], b: &[[T; 3]; 4], qq: T, qb: T) {
-    // M = [A B]·P, the first four rows of Φ·P.
     let mut m = [[T::ZERO; N]; 4];
-    for (i, row) in m.iter_mut().enumerate() {
-        for (j, entry) in row.iter_mut().enumerate() {
-            let mut acc = T::ZERO;
-            for k in 0..4 {
-                acc += a[i][k] * p[k][j];
-            }
-            for k in 0..3 {
-                acc += b[i][k] * p[4 + k][j];
-            }
-            *entry = acc;
+    for (mi, (ai, bi)) in m.iter_mut().zip(a.iter().zip(b)) {
+        for j in 0..N {
+            mi[j] = ai[0] * p[0][j]
+                + ai[1] * p[1][j]
+                + ai[2] * p[2][j]
+                + ai[3] * p[3][j]
+                + bi[0] * p[4][j]
+                + bi[1] * p[5][j]
+                + bi[2] * p[6][j];
         }
     }
-    // qq block: M·[A B]ᵀ (upper triangle), qb block: the last three columns of M.
-    for i in 0..4 {
+    // Columns of [A B] as rows: at[k][j] = A[j][k], bt[k][j] = B[j][k].
+    let mut at = [[T::ZERO; 4]; 4];
+    let mut bt = [[T::ZERO; 4]; 3];
+    for j in 0..4 {
+        for k in 0..4 {
+            at[k][j] = a[j][k];
+        }
+        for k in 0..3 {
+            bt[k][j] = b[j][k];
+        }
+    }
+    for (i, mi) in m.iter().enumerate() {
+        let mut row = [T::ZERO; 4];
+        for j in 0..4 {
+            row[j] = mi[0] * at[0][j]
+                + mi[1] * at[1][j]
+                + mi[2] * at[2][j]
+                + mi[3] * at[3][j]
+                + mi[4] * bt[0][j]
+                + mi[5] * bt[1][j]
+                + mi[6] * bt[2][j];
+        }
         for j in i..4 {
-            let mut acc = T::ZERO;
-            for k in 0..4 {
-                acc += m[i][k] * a[j][k];
-            }
-            for k in 0..3 {
-                acc += m[i][4 + k] * b[j][k];
-            }
-            p[i][j] = acc;
-            p[j][i] = acc;
+            p[i][j] = row[j];
+            p[j][i] = row[j];
         }
         for j in 4..N {
-            p[i][j] = m[i][j];
-            p[j][i] = m[i][j];
+            p[i][j] = mi[j];
+            p[j][i] = mi[j];
         }
     }
     for i in 0..4 {
@@ -60,26 +75,27 @@ pub fn predict<T: Real>(p: &mut Cov<T>, a: &[[T; 4]; 4], b: &[[T; 3]; 4], qq: T,
 /// `p` alone) when the innovation variance `s = h·P·hᵀ + r` is not finite and positive.
 ///
 /// Joseph form `P⁺ = (I − k h) P (I − k h)ᵀ + r k kᵀ`, expanded for a rank-one `k h` into
-/// `P⁺ = P − k uᵀ − u kᵀ + s k kᵀ` with `u = P hᵀ`. The expansion is exact for any gain, so it keeps
-/// the Joseph form's property that a rounding error in `k` changes `P⁺` only to second order;
-/// it costs O(n²) instead of two matrix products.
+/// `P⁺ = P − (k uᵀ + u kᵀ) + s·k kᵀ` with `u = P hᵀ`. The expansion is exact for any gain, so it
+/// keeps the Joseph form's property that a rounding error in `k` changes `P⁺` only to second
+/// order; it costs O(n²) instead of two matrix products. Each entry is computed as
+/// `(P_ij − (k_i u_j + u_i k_j)) + s·(k_i k_j)`, whose rounding is the same for `ij` and `ji`, so
+/// the full square stays exactly symmetric.
 #[inline(always)]
 pub fn scalar_update<T: Real>(p: &mut Cov<T>, h4: [T; 4], r: T) -> Option<[T; N]> {
+    // u = P hᵀ = Σ_k h_k·(row k of P), P symmetric.
     let mut u = [T::ZERO; N];
-    for (j, uj) in u.iter_mut().enumerate() {
-        *uj = p[j][0] * h4[0] + p[j][1] * h4[1] + p[j][2] * h4[2] + p[j][3] * h4[3];
+    for j in 0..N {
+        u[j] = h4[0] * p[0][j] + h4[1] * p[1][j] + h4[2] * p[2][j] + h4[3] * p[3][j];
     }
     let s = h4[0] * u[0] + h4[1] * u[1] + h4[2] * u[2] + h4[3] * u[3] + r;
     if !(s.is_finite() && s > T::ZERO) {
         return None;
     }
-    let inv = T::ONE / s;
-    let k = u.map(|uj| uj * inv);
-    for i in 0..N {
-        for j in i..N {
-            let v = p[i][j] - k[i] * u[j] - u[i] * k[j] + s * k[i] * k[j];
-            p[i][j] = v;
-            p[j][i] = v;
+    let k = crate::quat::scale(u, T::ONE / s);
+    for (i, row) in p.iter_mut().enumerate() {
+        let (ki, ui) = (k[i], u[i]);
+        for j in 0..N {
+            row[j] = (row[j] - (ki * u[j] + ui * k[j])) + s * (ki * k[j]);
         }
     }
     Some(k)
@@ -132,7 +148,11 @@ mod tests {
         let mut l = [[0.0; N]; N];
         for i in 0..N {
             for j in 0..=i {
-                l[i][j] = if i == j { 0.5 + i as f64 * 0.1 } else { 0.05 * (i + 2 * j) as f64 - 0.2 };
+                l[i][j] = if i == j {
+                    0.5 + i as f64 * 0.1
+                } else {
+                    0.05 * (i + 2 * j) as f64 - 0.2
+                };
             }
         }
         matmul(&l, &transpose(&l))
@@ -141,7 +161,12 @@ mod tests {
     fn assert_close(x: &Cov<f64>, y: &Cov<f64>) {
         for i in 0..N {
             for j in 0..N {
-                assert!((x[i][j] - y[i][j]).abs() < 1e-13, "[{i}][{j}] {} {}", x[i][j], y[i][j]);
+                assert!(
+                    (x[i][j] - y[i][j]).abs() < 1e-13,
+                    "[{i}][{j}] {} {}",
+                    x[i][j],
+                    y[i][j]
+                );
                 assert_eq!(x[i][j], x[j][i]);
             }
         }
@@ -149,8 +174,18 @@ mod tests {
 
     #[test]
     fn predict_is_phi_p_phi_transpose_plus_q() {
-        let a = [[1.0, -0.1, 0.2, 0.05], [0.1, 1.0, -0.3, 0.2], [-0.2, 0.3, 1.0, 0.1], [0.0, -0.2, -0.1, 1.0]];
-        let b = [[0.01, -0.02, 0.03], [0.04, 0.0, -0.01], [-0.02, 0.03, 0.01], [0.0, 0.05, -0.04]];
+        let a = [
+            [1.0, -0.1, 0.2, 0.05],
+            [0.1, 1.0, -0.3, 0.2],
+            [-0.2, 0.3, 1.0, 0.1],
+            [0.0, -0.2, -0.1, 1.0],
+        ];
+        let b = [
+            [0.01, -0.02, 0.03],
+            [0.04, 0.0, -0.01],
+            [-0.02, 0.03, 0.01],
+            [0.0, 0.05, -0.04],
+        ];
         let mut phi = [[0.0; N]; N];
         for i in 0..4 {
             phi[i][..4].copy_from_slice(&a[i]);

@@ -60,7 +60,7 @@ pub mod covariance;
 
 use crate::filter::{AttitudeFilter, Diagnostics, Imu};
 use crate::init::{parameter, Initial, Shared, DEFAULT_MAG_REFERENCE};
-use crate::quat::{cross, integrate, normalize, Quat, Vec3};
+use crate::quat::{axpy, cross, integrate, normalize, scale, Quat, Vec3};
 use crate::{Error, Real};
 use covariance::{is_sane, predict, scalar_update, Cov, N};
 
@@ -125,15 +125,21 @@ fn observe<T: Real>(q: Quat<T>, r: Vec3<T>) -> (Vec3<T>, [[T; 4]; 3]) {
     // p = q* ⊗ (0, r) = (v·r, w·r − v × r); h = vec(p ⊗ q) = p₀·v + w·p_v + p_v × v.
     let p0 = v[0] * r[0] + v[1] * r[1] + v[2] * r[2];
     let vr = cross(v, r);
-    let pv = [0, 1, 2].map(|i| w * r[i] - vr[i]);
-    let pq = cross(pv, v);
-    let predicted = [0, 1, 2].map(|i| p0 * v[i] + w * pv[i] + pq[i]);
+    let pv = axpy(scale(r, w), -T::ONE, vr);
+    let predicted = axpy(axpy(scale(v, p0), w, pv), T::ONE, cross(pv, v));
     let rows = [
         [pv[0], p0, -pv[2], pv[1]],
         [pv[1], pv[2], p0, -pv[0]],
         [pv[2], -pv[1], pv[0], p0],
     ];
-    (predicted, rows.map(|row| row.map(|c| c + c)))
+    (
+        predicted,
+        [
+            scale(rows[0], T::TWO),
+            scale(rows[1], T::TWO),
+            scale(rows[2], T::TWO),
+        ],
+    )
 }
 
 /// The blocks of `Φ = [[A, B], [0, I]]` for `q⁻ = q + h·q ⊗ (0, g − b)` at the bias-corrected
@@ -203,7 +209,8 @@ impl<T: Real> Ekf<T> {
     fn correct(&mut self, q: Quat<T>, r: Vec3<T>, z: Vec3<T>, var: T, dx: &mut [T; N]) {
         let (predicted, rows) = observe(q, r);
         for (i, h) in rows.into_iter().enumerate() {
-            let y = z[i] - predicted[i] - (h[0] * dx[0] + h[1] * dx[1] + h[2] * dx[2] + h[3] * dx[3]);
+            let y =
+                z[i] - predicted[i] - (h[0] * dx[0] + h[1] * dx[1] + h[2] * dx[2] + h[3] * dx[3]);
             match scalar_update(&mut self.p, h, var) {
                 Some(k) => {
                     for j in 0..N {
@@ -222,10 +229,16 @@ impl<T: Real> AttitudeFilter<T> for Ekf<T> {
             return;
         };
         let (q, p_old) = (self.s.q, self.p);
-        let w = [0, 1, 2].map(|i| step.gyro[i] - self.bias[i]);
+        let w = axpy(step.gyro, -T::ONE, self.bias);
         let h = T::HALF * step.dt;
         let (a, b) = transition(q, w, h);
-        predict(&mut self.p, &a, &b, self.q_att * step.dt, self.q_bias * step.dt);
+        predict(
+            &mut self.p,
+            &a,
+            &b,
+            self.q_att * step.dt,
+            self.q_bias * step.dt,
+        );
         let Some(q_pred) = normalize(integrate(q, w, step.dt)) else {
             self.p = p_old;
             self.s.diag.rejected += 1;
@@ -239,8 +252,8 @@ impl<T: Real> AttitudeFilter<T> for Ekf<T> {
         if let Some(mag) = step.mag {
             self.correct(q_pred, self.s.mag_ref, mag, self.r_mag, &mut dx);
         }
-        let bias = [0, 1, 2].map(|i| self.bias[i] + dx[4 + i]);
-        let q_new = normalize([0, 1, 2, 3].map(|i| q_pred[i] + dx[i]));
+        let bias = axpy(self.bias, T::ONE, [dx[4], dx[5], dx[6]]);
+        let q_new = normalize(axpy(q_pred, T::ONE, [dx[0], dx[1], dx[2], dx[3]]));
         match q_new {
             Some(q_new) if is_sane(&self.p) && bias.iter().all(|c| c.is_finite()) => {
                 self.s.q = q_new;
@@ -281,7 +294,12 @@ mod tests {
 
     #[test]
     fn transition_matrix_matches_finite_differences() {
-        let (q, g, bias, h) = (from_euler_zyx([0.4f64, -1.1, 2.9]), [3.0, -20.0, 45.0], [0.1, 0.2, -0.3], 0.0025);
+        let (q, g, bias, h) = (
+            from_euler_zyx([0.4f64, -1.1, 2.9]),
+            [3.0, -20.0, 45.0],
+            [0.1, 0.2, -0.3],
+            0.0025,
+        );
         let step = |x: [f64; 7]| {
             let w = [0, 1, 2].map(|i| g[i] - x[4 + i]);
             integrate([x[0], x[1], x[2], x[3]], w, 2.0 * h)

@@ -51,15 +51,33 @@ pub fn filters_at<T: Real>(q0: [f64; 4]) -> Vec<(&'static str, Box<dyn AttitudeF
     vec![
         (
             "ecf",
-            Box::new(Ecf::new(&EcfConfig { initial, ..EcfConfig::default() }).unwrap()),
+            Box::new(
+                Ecf::new(&EcfConfig {
+                    initial,
+                    ..EcfConfig::default()
+                })
+                .unwrap(),
+            ),
         ),
         (
             "gda",
-            Box::new(Gda::new(&GdaConfig { initial, ..GdaConfig::default() }).unwrap()),
+            Box::new(
+                Gda::new(&GdaConfig {
+                    initial,
+                    ..GdaConfig::default()
+                })
+                .unwrap(),
+            ),
         ),
         (
             "ekf",
-            Box::new(Ekf::new(&EkfConfig { initial, ..EkfConfig::default() }).unwrap()),
+            Box::new(
+                Ekf::new(&EkfConfig {
+                    initial,
+                    ..EkfConfig::default()
+                })
+                .unwrap(),
+            ),
         ),
     ]
 }
@@ -123,7 +141,11 @@ impl Scene {
             dtheta * cp + dpsi * ct * sp,
             -dtheta * sp + dpsi * ct * cp,
         ];
-        let gate = if self.external_acceleration { (TAU * 0.05 * t).sin().max(0.0) } else { 0.0 };
+        let gate = if self.external_acceleration {
+            (TAU * 0.05 * t).sin().max(0.0)
+        } else {
+            0.0
+        };
         let a_w = [
             4.0 * G * gate * (TAU * 1.3 * t).sin(),
             4.0 * G * gate * (TAU * 0.7 * t + 1.0).sin(),
@@ -141,12 +163,23 @@ impl Scene {
             magnetic_field: m,
             ..Truth::default()
         });
-        (q, Imu { gyro: s.gyr, acc: s.acc, mag: s.mag })
+        (
+            q,
+            Imu {
+                gyro: s.gyr,
+                acc: s.acc,
+                mag: s.mag,
+            },
+        )
     }
 }
 
 /// An `f32` sample in `f64`.
 pub fn widen(imu: &Imu<f32>) -> Imu<f64> {
     let w = |v: [f32; 3]| v.map(f64::from);
-    Imu { gyro: w(imu.gyro), acc: w(imu.acc), mag: w(imu.mag) }
+    Imu {
+        gyro: w(imu.gyro),
+        acc: w(imu.acc),
+        mag: w(imu.mag),
+    }
 }
