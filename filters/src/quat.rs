@@ -65,7 +65,7 @@ pub fn axpy<T: Real, const N: usize>(a: [T; N], s: T, b: [T; N]) -> [T; N] {
 pub fn scale<T: Real, const N: usize>(v: [T; N], s: T) -> [T; N] {
     let mut out = v;
     for c in &mut out {
-        *c = *c * s;
+        *c *= s;
     }
     out
 }

@@ -65,10 +65,10 @@ impl<T: Real> Bank<T> {
 
     fn check_covariance(&mut self, k: usize) {
         let p: Cov<T> = self.ekf.covariance();
-        for i in 0..N {
-            for j in 0..N {
-                assert!(p[i][j].is_finite(), "P[{i}][{j}] at {k}");
-                assert_eq!(p[i][j], p[j][i], "P not symmetric at {k}");
+        for (i, row) in p.iter().enumerate() {
+            for (j, v) in row.iter().enumerate() {
+                assert!(v.is_finite(), "P[{i}][{j}] at {k}");
+                assert_eq!(*v, p[j][i], "P not symmetric at {k}");
             }
         }
         let m = SMatrix::<f64, N, N>::from_fn(|i, j| p[i][j].to_f64());

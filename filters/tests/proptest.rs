@@ -72,10 +72,10 @@ fn check_unit<T: Real>(q: Quat<T>, what: &str) {
 
 fn check_ekf<T: Real>(ekf: &Ekf<T>) {
     let p = ekf.covariance();
-    for i in 0..7 {
-        assert!(p[i][i] > T::ZERO, "P[{i}][{i}] = {:?}", p[i][i]);
-        for j in 0..7 {
-            assert!(p[i][j].is_finite() && p[i][j] == p[j][i], "P[{i}][{j}]");
+    for (i, row) in p.iter().enumerate() {
+        assert!(row[i] > T::ZERO, "P[{i}][{i}] = {:?}", row[i]);
+        for (j, v) in row.iter().enumerate() {
+            assert!(v.is_finite() && *v == p[j][i], "P[{i}][{j}]");
         }
     }
     assert!(ekf.bias().iter().all(|c| c.is_finite()));

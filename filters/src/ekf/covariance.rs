@@ -62,11 +62,8 @@ pub fn predict<T: Real>(p: &mut Cov<T>, a: &[[T; 4]; 4], b: &[[T; 3]; 4], qq: T,
             p[j][i] = mi[j];
         }
     }
-    for i in 0..4 {
-        p[i][i] += qq;
-    }
-    for i in 4..N {
-        p[i][i] += qb;
+    for (i, row) in p.iter_mut().enumerate() {
+        row[i] += if i < 4 { qq } else { qb };
     }
 }
 
@@ -117,6 +114,8 @@ pub fn is_sane<T: Real>(p: &Cov<T>) -> bool {
 }
 
 #[cfg(test)]
+// The reference computations index matrices the way the formulas write them.
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
 
