@@ -78,42 +78,18 @@ fn bench(c: &mut Criterion) {
     let double: Vec<Imu<f64>> = single.iter().map(widen).collect();
     baseline!(c, f32, "baseline_ahrs_madgwick_f32", single);
     baseline!(c, f64, "baseline_ahrs_madgwick_f64", double);
-    bench_filter(
-        c,
-        "ecf_f32",
-        Ecf::<f32>::new(&EcfConfig::default()).unwrap(),
-        &single,
-    );
-    bench_filter(
-        c,
-        "ecf_f64",
-        Ecf::<f64>::new(&EcfConfig::default()).unwrap(),
-        &double,
-    );
-    bench_filter(
-        c,
-        "gda_f32",
-        Gda::<f32>::new(&GdaConfig::default()).unwrap(),
-        &single,
-    );
-    bench_filter(
-        c,
-        "gda_f64",
-        Gda::<f64>::new(&GdaConfig::default()).unwrap(),
-        &double,
-    );
-    bench_filter(
-        c,
-        "ekf_f32",
-        Ekf::<f32>::new(&EkfConfig::default()).unwrap(),
-        &single,
-    );
-    bench_filter(
-        c,
-        "ekf_f64",
-        Ekf::<f64>::new(&EkfConfig::default()).unwrap(),
-        &double,
-    );
+    bench_all(c, "f32", &single);
+    bench_all(c, "f64", &double);
+}
+
+/// ECF, GDA and EKF with default parameters in `T`.
+fn bench_all<T: Real>(c: &mut Criterion, ty: &str, input: &[Imu<T>]) {
+    let ecf = Ecf::<T>::new(&EcfConfig::default()).unwrap();
+    let gda = Gda::<T>::new(&GdaConfig::default()).unwrap();
+    let ekf = Ekf::<T>::new(&EkfConfig::default()).unwrap();
+    bench_filter(c, &format!("ecf_{ty}"), ecf, input);
+    bench_filter(c, &format!("gda_{ty}"), gda, input);
+    bench_filter(c, &format!("ekf_{ty}"), ekf, input);
 }
 
 criterion_group!(benches, bench);

@@ -3,9 +3,7 @@
 #![allow(dead_code)]
 
 use margemu_filters::quat::{from_euler_zyx, mul, world_to_body, Quat};
-use margemu_filters::{
-    AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, Imu, Initial, Real,
-};
+use margemu_filters::{Imu, Real};
 use margemu_model::perturbation::{Complex, Perturbation, PerturbationConfig, PerturbationPlan};
 use margemu_model::sensor::{Marg, MargConfig, Truth};
 use std::f64::consts::{PI, TAU};
@@ -43,43 +41,6 @@ pub fn static_imu<T: Real>(q: [f64; 4], gyro: [f64; 3]) -> Imu<T> {
 pub fn turned(q: Quat<f64>, axis: [f64; 3], angle: f64) -> Quat<f64> {
     let (s, c) = (0.5 * angle).sin_cos();
     mul(q, [c, s * axis[0], s * axis[1], s * axis[2]])
-}
-
-/// The three filters with default parameters, starting at `q0`.
-pub fn filters_at<T: Real>(q0: [f64; 4]) -> Vec<(&'static str, Box<dyn AttitudeFilter<T>>)> {
-    let initial = Initial::Attitude(q0);
-    vec![
-        (
-            "ecf",
-            Box::new(
-                Ecf::new(&EcfConfig {
-                    initial,
-                    ..EcfConfig::default()
-                })
-                .unwrap(),
-            ),
-        ),
-        (
-            "gda",
-            Box::new(
-                Gda::new(&GdaConfig {
-                    initial,
-                    ..GdaConfig::default()
-                })
-                .unwrap(),
-            ),
-        ),
-        (
-            "ekf",
-            Box::new(
-                Ekf::new(&EkfConfig {
-                    initial,
-                    ..EkfConfig::default()
-                })
-                .unwrap(),
-            ),
-        ),
-    ]
 }
 
 /// Euler angles and their first derivatives of a sum of sines `Σ a·sin(2π f t + φ) + rate·t`.
