@@ -91,6 +91,10 @@ pub(crate) fn parameter<T: Real>(
     if !v.is_finite() {
         return Err(Error::ParameterTooLarge { what });
     }
+    if positive && v <= T::ZERO {
+        // Positive in f64 but below the smallest subnormal of T.
+        return Err(Error::NonPositiveParameter { what });
+    }
     Ok(v)
 }
 

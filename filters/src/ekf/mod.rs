@@ -174,8 +174,11 @@ fn diagonal<T: Real>(a: T, b: T) -> Cov<T> {
 impl<T: Real> Ekf<T> {
     /// A filter with the parameters of `cfg`, checked.
     pub fn new(cfg: &EkfConfig) -> Result<Self, Error> {
-        let square = |v: f64, what| parameter::<T>(v * v, what, true);
-        parameter::<T>(cfg.gyro_noise, "gyro_noise", true)?;
+        // A standard deviation, checked, then its square, checked in T.
+        let square = |v: f64, what| {
+            let std = parameter::<f64>(v, what, true)?;
+            parameter::<T>(std * std, what, true)
+        };
         let p0 = diagonal(
             square(cfg.initial_attitude_std, "initial_attitude_std")?,
             square(cfg.initial_bias_std, "initial_bias_std")?,
@@ -290,6 +293,77 @@ mod tests {
     fn h(q: Quat<f64>, r: Vec3<f64>) -> Vec3<f64> {
         let p = mul(mul([q[0], -q[1], -q[2], -q[3]], [0.0, r[0], r[1], r[2]]), q);
         [p[1], p[2], p[3]]
+    }
+
+    #[test]
+    fn invalid_parameters_are_refused() {
+        let bad = |cfg: EkfConfig| Ekf::<f32>::new(&cfg).unwrap_err();
+        let d = EkfConfig::default();
+        let what = |what| Error::NonPositiveParameter { what };
+        assert_eq!(
+            bad(EkfConfig {
+                accel_noise: -0.5,
+                ..d
+            }),
+            what("accel_noise")
+        );
+        assert_eq!(
+            bad(EkfConfig {
+                gyro_bias_walk: 0.0,
+                ..d
+            }),
+            what("gyro_bias_walk")
+        );
+        // Its square is below f32's range.
+        assert_eq!(
+            bad(EkfConfig {
+                mag_noise: 1e-30,
+                ..d
+            }),
+            what("mag_noise")
+        );
+        assert_eq!(
+            bad(EkfConfig {
+                gyro_noise: 1e30,
+                ..d
+            }),
+            Error::ParameterTooLarge { what: "gyro_noise" }
+        );
+        assert_eq!(
+            bad(EkfConfig {
+                initial_bias_std: f64::NAN,
+                ..d
+            }),
+            Error::NonFiniteParameter {
+                what: "initial_bias_std"
+            }
+        );
+        assert_eq!(
+            bad(EkfConfig {
+                mag_reference: [0.0, 0.0, -1.0],
+                ..d
+            }),
+            Error::VerticalMagneticReference
+        );
+        assert_eq!(
+            bad(EkfConfig {
+                mag_reference: [0.0; 3],
+                ..d
+            }),
+            Error::ZeroMagneticReference
+        );
+        assert_eq!(
+            bad(EkfConfig {
+                initial: Initial::Attitude([0.0; 4]),
+                ..d
+            }),
+            Error::ZeroInitialAttitude
+        );
+        assert!(Ekf::<f64>::new(&EkfConfig {
+            mag_noise: 1e-30,
+            ..d
+        })
+        .is_ok());
     }
 
     #[test]
