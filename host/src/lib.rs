@@ -13,13 +13,15 @@
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
 //! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
-//! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs.
+//! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs;
+//! - [`evaluate`](mod@evaluate): scores of a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned and split by phase.
 #![warn(missing_docs)]
 
 pub mod analysis;
 pub mod bench;
 pub mod bus;
 pub mod csv_column;
+pub mod evaluate;
 pub mod loopback;
 pub mod marg;
 pub mod motion;

@@ -40,7 +40,7 @@ const FONT_PATHS: [&str; 4] = [
 ];
 
 /// Registers a system font as `sans-serif` once per process.
-fn ensure_font() -> Result<(), PlotError> {
+pub(crate) fn ensure_font() -> Result<(), PlotError> {
     use std::sync::OnceLock;
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
@@ -68,12 +68,22 @@ fn ensure_font() -> Result<(), PlotError> {
 
 /// Draws the Allan deviation and the PSD of `name` to `path` (.png or .svg).
 pub fn noise(path: &Path, name: &str, allan: &[AllanPoint], psd: &Psd) -> Result<(), PlotError> {
+    render(path, (900, 900), &Noise { name, allan, psd })
+}
+
+/// A figure that draws itself onto any `plotters` backend.
+pub(crate) trait Figure {
+    /// Draws onto `root`.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB>;
+}
+
+/// Draws `figure` to `path`, PNG or SVG by the extension, `size` pixels.
+pub(crate) fn render(path: &Path, size: (u32, u32), figure: &impl Figure) -> Result<(), PlotError> {
     ensure_font()?;
     let fail = |e: String| PlotError::Draw {
         path: path.to_path_buf(),
         reason: e,
     };
-    let size = (900, 900);
     match path
         .extension()
         .and_then(|e| e.to_str())
@@ -82,12 +92,12 @@ pub fn noise(path: &Path, name: &str, allan: &[AllanPoint], psd: &Psd) -> Result
     {
         Some("png") => {
             let root = BitMapBackend::new(path, size).into_drawing_area();
-            draw(&root, name, allan, psd).map_err(|e| fail(e.to_string()))?;
+            figure.draw(&root).map_err(|e| fail(e.to_string()))?;
             root.present().map_err(|e| fail(e.to_string()))
         }
         Some("svg") => {
             let root = SVGBackend::new(path, size).into_drawing_area();
-            draw(&root, name, allan, psd).map_err(|e| fail(e.to_string()))?;
+            figure.draw(&root).map_err(|e| fail(e.to_string()))?;
             root.present().map_err(|e| fail(e.to_string()))
         }
         _ => Err(PlotError::UnknownFormat {
@@ -96,7 +106,21 @@ pub fn noise(path: &Path, name: &str, allan: &[AllanPoint], psd: &Psd) -> Result
     }
 }
 
-type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+/// The result of drawing on a backend.
+pub(crate) type DrawResult<DB> =
+    Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+struct Noise<'a> {
+    name: &'a str,
+    allan: &'a [AllanPoint],
+    psd: &'a Psd,
+}
+
+impl Figure for Noise<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        draw(root, self.name, self.allan, self.psd)
+    }
+}
 
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,

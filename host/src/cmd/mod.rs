@@ -2,6 +2,7 @@
 
 pub mod analyze;
 pub mod bench;
+pub mod evaluate;
 pub mod loopback;
 pub mod ports;
 pub mod scene;
@@ -28,6 +29,8 @@ pub enum Command {
     Stream(stream::Cmd),
     /// List serial ports.
     Ports(ports::Cmd),
+    /// Score a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned.
+    Evaluate(evaluate::Cmd),
 }
 
 impl Command {
@@ -40,6 +43,7 @@ impl Command {
             Command::Analyze(c) => c.run(),
             Command::Stream(c) => c.run(),
             Command::Ports(c) => c.run(),
+            Command::Evaluate(c) => c.run(),
         }
     }
 }

@@ -1,0 +1,96 @@
+//! Cost of one update of each filter, in `f32` and `f64`, on realistic input: 4096 samples of the
+//! paper-like scene of the tests (200 Hz, the paper's noise, ±50 rad/s oscillations, ±4 g
+//! external accelerations, magnetic bursts), replayed in a loop.
+//!
+//! The baseline is the `ahrs` crate's Madgwick filter (MARG update, nalgebra), a plain Rust
+//! implementation of the same algorithm family, timed in the same run so that ratios hold on a
+//! shared machine.
+//!
+//! `cargo bench -p margemu-filters -- --warm-up-time 1 --measurement-time 3`
+
+// criterion_group! generates an undocumented public function.
+#![allow(missing_docs)]
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::{widen, Scene};
+use criterion::{criterion_group, criterion_main, Criterion};
+use margemu_filters::{AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, Imu, Real};
+use std::hint::black_box;
+
+const SAMPLES: usize = 4096;
+
+fn samples() -> Vec<Imu<f32>> {
+    let mut scene = Scene::new(200.0, 3);
+    // Skip the first seconds so that bursts and accelerations are under way.
+    (0..2000 + SAMPLES)
+        .map(|_| scene.next().1)
+        .skip(2000)
+        .collect()
+}
+
+fn bench_filter<T: Real, F: AttitudeFilter<T>>(
+    c: &mut Criterion,
+    name: &str,
+    mut f: F,
+    input: &[Imu<T>],
+) {
+    let dt = T::from_f64(0.005);
+    for imu in input {
+        f.update(imu, dt);
+    }
+    let mut k = 0;
+    c.bench_function(name, |b| {
+        b.iter(|| {
+            f.update(black_box(&input[k]), black_box(dt));
+            k = (k + 1) % SAMPLES;
+            black_box(f.quaternion())
+        })
+    });
+}
+
+/// The `ahrs` crate's Madgwick MARG update over the same samples.
+macro_rules! baseline {
+    ($c:expr, $t:ty, $name:expr, $input:expr) => {{
+        use ahrs::{Ahrs, Madgwick};
+        use nalgebra_for_ahrs::Vector3;
+        let v = |a: [$t; 3]| Vector3::new(a[0], a[1], a[2]);
+        let input: Vec<[Vector3<$t>; 3]> = $input
+            .iter()
+            .map(|i| [v(i.gyro), v(i.acc), v(i.mag)])
+            .collect();
+        let mut f = Madgwick::<$t>::new(0.005, 0.1);
+        let mut k = 0;
+        $c.bench_function($name, |b| {
+            b.iter(|| {
+                let [g, a, m] = black_box(&input[k]);
+                let q = f.update(g, a, m).map(|q| *q);
+                k = (k + 1) % SAMPLES;
+                black_box(q)
+            })
+        });
+    }};
+}
+
+fn bench(c: &mut Criterion) {
+    let single = samples();
+    let double: Vec<Imu<f64>> = single.iter().map(widen).collect();
+    baseline!(c, f32, "baseline_ahrs_madgwick_f32", single);
+    baseline!(c, f64, "baseline_ahrs_madgwick_f64", double);
+    bench_all(c, "f32", &single);
+    bench_all(c, "f64", &double);
+}
+
+/// ECF, GDA and EKF with default parameters in `T`.
+fn bench_all<T: Real>(c: &mut Criterion, ty: &str, input: &[Imu<T>]) {
+    let ecf = Ecf::<T>::new(&EcfConfig::default()).unwrap();
+    let gda = Gda::<T>::new(&GdaConfig::default()).unwrap();
+    let ekf = Ekf::<T>::new(&EkfConfig::default()).unwrap();
+    bench_filter(c, &format!("ecf_{ty}"), ecf, input);
+    bench_filter(c, &format!("gda_{ty}"), gda, input);
+    bench_filter(c, &format!("ekf_{ty}"), ekf, input);
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

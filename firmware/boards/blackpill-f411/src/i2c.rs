@@ -1,0 +1,171 @@
+//! I2C1 as the MPU-9250's I2C target, through the PAC (the HAL has no target mode): own address
+//! 0x68 (0x69 with AD0 high), and 0x0C for the AK8963 while the chip is in bypass mode (dual
+//! addressing, OAR2), clock stretching on (RM0383, I2C chapter).
+//!
+//! | pin | function (AF4, open drain) |
+//! |-----|----------------------------|
+//! | PB6 | I2C1_SCL |
+//! | PB7 | I2C1_SDA |
+//!
+//! The event and error interrupts (priority [`PRIORITY`], below the SPI handler's) drive the
+//! chip's [`I2cTarget`] byte by byte, holding the device for a few microseconds each. While the
+//! main loop holds the device ([`crate::device::lock`]) they wait, and the target stretches SCL.
+//!
+//! Reads are fetched only when the controller asks for the byte: the first at the address
+//! match, each next one at BTF (the previous byte was acknowledged and the data register is
+//! empty: EV3 of RM0383's slave transmitter sequence), with the buffer interrupt off, so a read
+//! never pops a FIFO byte the controller does not take. A NACK (AF) ends a read (STOPF is not
+//! set after a NACK: RM0383, I2C_SR1). Writes are taken at RXNE.
+
+use core::sync::atomic::{AtomicBool, Ordering};
+
+use cortex_m::peripheral::NVIC;
+use margemu_firmware::chip::{I2cTarget, Mpu9250};
+use margemu_firmware::protocol::regmap::ak8963;
+use margemu_firmware::protocol::regmap::mpu9250::{bits, reg};
+use stm32f4xx_hal::pac::{self, interrupt, Interrupt, I2C1};
+use stm32f4xx_hal::rcc::{Enable, Rcc, Reset};
+
+use crate::device;
+
+/// Priority of I2C1_EV and I2C1_ER, and the BASEPRI of [`device::lock`].
+pub const PRIORITY: u8 = 0x10;
+
+const CR1_PE: u16 = 1 << 0;
+const CR1_ACK: u16 = 1 << 10;
+const CR2_ITERREN: u16 = 1 << 8;
+const CR2_ITEVTEN: u16 = 1 << 9;
+const CR2_ITBUFEN: u16 = 1 << 10;
+/// OAR1 bit 14 "should always be kept at 1 by software".
+const OAR1_KEEP: u16 = 1 << 14;
+const OAR2_ENDUAL: u16 = 1 << 0;
+/// SR1 error flags (rc_w0): BERR, ARLO, AF, OVR, PECERR, TIMEOUT, SMBALERT.
+const SR1_ERRORS: u16 = 0xDF00;
+
+/// A transaction ended since the main loop last looked: the chip may have changed.
+static ACTIVITY: AtomicBool = AtomicBool::new(false);
+
+/// Enables I2C1 as a target (clock from `pclk1_hz`) and its interrupts. The pins must already be
+/// in AF4 open drain. The own address is set by [`configure`].
+pub fn init(_i2c: I2C1, rcc: &mut Rcc, pclk1_hz: u32) {
+    I2C1::enable(rcc);
+    I2C1::reset(rcc);
+    let i2c = regs();
+    let freq = (pclk1_hz / 1_000_000).clamp(2, 50) as u16;
+    i2c.cr2()
+        .write(|w| unsafe { w.bits(freq | CR2_ITEVTEN | CR2_ITERREN) });
+    i2c.oar1()
+        .write(|w| unsafe { w.bits(OAR1_KEEP | u16::from(0x68u8) << 1) });
+    i2c.cr1().write(|w| unsafe { w.bits(CR1_PE) });
+    // ACK only sticks once PE is set.
+    i2c.cr1().write(|w| unsafe { w.bits(CR1_PE | CR1_ACK) });
+    // SAFETY: the handlers only use the device once it is installed; priorities before unmasking.
+    unsafe {
+        let mut nvic = cortex_m::Peripherals::steal().NVIC;
+        nvic.set_priority(Interrupt::I2C1_EV, PRIORITY);
+        nvic.set_priority(Interrupt::I2C1_ER, PRIORITY);
+        NVIC::unmask(Interrupt::I2C1_EV);
+        NVIC::unmask(Interrupt::I2C1_ER);
+    }
+}
+
+/// Follows the chip's bus state: its address (AD0), whether the AK8963 answers (bypass), and
+/// whether the I2C interface is enabled at all (USER_CTRL.I2C_IF_DIS). Called with the device
+/// locked, so no transaction is being handled.
+pub fn configure(chip: &Mpu9250) {
+    let i2c = regs();
+    let oar1 = OAR1_KEEP | u16::from(chip.i2c_address()) << 1;
+    let mut oar2 = u16::from(ak8963::I2C_ADDRESS) << 1;
+    if chip.bypass_active() {
+        oar2 |= OAR2_ENDUAL;
+    }
+    let enabled = chip.peek(reg::USER_CTRL) & bits::USER_I2C_IF_DIS == 0;
+    if i2c.oar1().read().bits() != oar1 {
+        i2c.oar1().write(|w| unsafe { w.bits(oar1) });
+    }
+    if i2c.oar2().read().bits() != oar2 {
+        i2c.oar2().write(|w| unsafe { w.bits(oar2) });
+    }
+    let cr1 = i2c.cr1().read().bits();
+    let want = if enabled {
+        cr1 | CR1_ACK
+    } else {
+        cr1 & !CR1_ACK
+    };
+    if want != cr1 {
+        i2c.cr1().write(|w| unsafe { w.bits(want) });
+    }
+}
+
+/// Whether an I2C transaction ended since the last call.
+pub fn take_activity() -> bool {
+    ACTIVITY.swap(false, Ordering::Relaxed)
+}
+
+fn regs() -> &'static pac::i2c1::RegisterBlock {
+    // SAFETY: I2C1 belongs to this module since `init`.
+    unsafe { &*I2C1::ptr() }
+}
+
+#[interrupt]
+fn I2C1_EV() {
+    let i2c = regs();
+    let sr1 = i2c.sr1().read();
+    // SAFETY: an I2C handler at PRIORITY.
+    let Some(device) = (unsafe { device::in_i2c_handler() }) else {
+        return;
+    };
+    let chip = device.chip_mut();
+    if sr1.addr().bit_is_set() {
+        let sr2 = i2c.sr2().read(); // SR1 then SR2 clears ADDR
+        let read = sr2.tra().bit_is_set();
+        let address = if sr2.dualf().bit_is_set() {
+            ak8963::I2C_ADDRESS
+        } else {
+            chip.i2c_address()
+        };
+        chip.start(address, read);
+        let cr2 = i2c.cr2().read().bits();
+        if read {
+            i2c.cr2().write(|w| unsafe { w.bits(cr2 & !CR2_ITBUFEN) });
+            let byte = chip.read();
+            i2c.dr().write(|w| unsafe { w.bits(u16::from(byte)) });
+        } else {
+            i2c.cr2().write(|w| unsafe { w.bits(cr2 | CR2_ITBUFEN) });
+        }
+        return;
+    }
+    if sr1.rx_ne().bit_is_set() {
+        let byte = i2c.dr().read().bits() as u8;
+        chip.write(byte);
+    } else if sr1.tx_e().bit_is_set() && sr1.btf().bit_is_set() {
+        let byte = chip.read();
+        i2c.dr().write(|w| unsafe { w.bits(u16::from(byte)) });
+    }
+    if sr1.stopf().bit_is_set() {
+        // SR1 read, then a CR1 write, clears STOPF.
+        i2c.cr1().modify(|r, w| unsafe { w.bits(r.bits()) });
+        end(chip);
+    }
+}
+
+#[interrupt]
+fn I2C1_ER() {
+    let i2c = regs();
+    let sr1 = i2c.sr1().read();
+    i2c.sr1().write(|w| unsafe { w.bits(!SR1_ERRORS) });
+    if sr1.af().bit_is_set() {
+        // SAFETY: an I2C handler at PRIORITY.
+        if let Some(device) = unsafe { device::in_i2c_handler() } {
+            end(device.chip_mut());
+        }
+    }
+}
+
+fn end(chip: &mut Mpu9250) {
+    chip.stop();
+    let i2c = regs();
+    i2c.cr2()
+        .modify(|r, w| unsafe { w.bits(r.bits() & !CR2_ITBUFEN) });
+    ACTIVITY.store(true, Ordering::Relaxed);
+}

@@ -1,0 +1,134 @@
+//! `margemu evaluate`: scores a device's or a filter's attitude against the truth (library:
+//! `margemu::evaluate`).
+
+use anyhow::{bail, Result};
+use margemu::evaluate::{
+    report, EvalOptions, LatencyMode, LatencySearch, PhaseRules, ScoreOptions, Source,
+};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Cmd {
+    /// A session directory (truth.csv, meta.toml, dut_attitude.csv), or with --estimates any run
+    /// directory with a truth.csv (simulate output).
+    dir: Option<PathBuf>,
+    /// Estimates `t_s,qw,qx,qy,qz` (s from the scene start, or the external recording's axis).
+    #[arg(long)]
+    estimates: Option<PathBuf>,
+    /// An external recording `t_s,ax,ay,az,gx,gy,gz,mx,my,mz,qw,qx,qy,qz[,qw_est,qx_est,qy_est,qz_est]`.
+    #[arg(long, conflicts_with = "dir")]
+    external: Option<PathBuf>,
+    /// Where report.md, errors.csv and the figures go (default: the session directory, or
+    /// `<recording>-evaluation/` beside an external recording).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// `auto` (estimate it) or a fixed latency in ms (default: auto for sessions, 0 otherwise).
+    #[arg(long)]
+    latency: Option<String>,
+    /// Largest latency searched either way (ms).
+    #[arg(long, default_value_t = 500.0)]
+    max_lag: f64,
+    /// Seconds at the start left out of the scores (filter convergence).
+    #[arg(long, default_value_t = 0.0)]
+    warmup: f64,
+    /// Truth samples further apart than this (ms) are not interpolated across (default: 4 ×
+    /// their median spacing).
+    #[arg(long)]
+    max_gap: Option<f64>,
+    /// Keep only dut_attitude.csv rows with this `message`.
+    #[arg(long)]
+    message: Option<String>,
+    /// Stamp device output with its host arrival time even when it carries device times.
+    #[arg(long)]
+    host_time: bool,
+    /// Static phase: body rate below this (rad/s).
+    #[arg(long, default_value_t = 0.05)]
+    static_rate: f64,
+    /// Static phase: external acceleration below this (m/s²).
+    #[arg(long, default_value_t = 0.1)]
+    static_accel: f64,
+    /// Magnetic phase: field deviation above this fraction of the reference norm.
+    #[arg(long, default_value_t = 0.1)]
+    mag_threshold: f64,
+    /// Averaging window of measured signals for the phases (ms).
+    #[arg(long, default_value_t = 100.0)]
+    window: f64,
+    /// Skip the figures.
+    #[arg(long)]
+    no_plots: bool,
+}
+
+fn ms_to_ns(name: &str, ms: f64) -> Result<u64> {
+    if !(ms.is_finite() && ms >= 0.0) {
+        bail!("--{name} must be a finite number ≥ 0, not {ms}");
+    }
+    Ok((ms * 1e6).round() as u64)
+}
+
+impl Cmd {
+    pub fn run(self) -> Result<()> {
+        let (source, default_out) = match (&self.dir, &self.external) {
+            (None, Some(file)) => {
+                let stem = file.file_stem().unwrap_or_default().to_string_lossy();
+                let out = file.with_file_name(format!("{stem}-evaluation"));
+                let estimates = self.estimates.clone();
+                (
+                    Source::External {
+                        file: file.clone(),
+                        estimates,
+                    },
+                    out,
+                )
+            }
+            (Some(dir), None) => match &self.estimates {
+                Some(estimates) => {
+                    let estimates = estimates.clone();
+                    (
+                        Source::Estimates {
+                            dir: dir.clone(),
+                            estimates,
+                        },
+                        dir.clone(),
+                    )
+                }
+                None => (Source::Session(dir.clone()), dir.clone()),
+            },
+            _ => bail!("give a session or run directory, or --external FILE"),
+        };
+        let latency = match self.latency.as_deref() {
+            None => None,
+            Some("auto") => Some(LatencyMode::Auto),
+            Some(text) => match text.parse::<f64>() {
+                Ok(ms) if ms.is_finite() => Some(LatencyMode::Fixed((ms * 1e6).round() as i64)),
+                _ => bail!("--latency must be `auto` or a number of ms, not {text:?}"),
+            },
+        };
+        let options = EvalOptions {
+            latency,
+            search: LatencySearch {
+                max_lag_ns: ms_to_ns("max-lag", self.max_lag)?,
+                step_ns: None,
+                score: ScoreOptions {
+                    latency_ns: 0,
+                    warmup_ns: ms_to_ns("warmup", self.warmup * 1e3)?,
+                    max_gap_ns: self.max_gap.map(|g| ms_to_ns("max-gap", g)).transpose()?,
+                },
+            },
+            message: self.message,
+            device_time: !self.host_time,
+            rules: PhaseRules {
+                static_rate: self.static_rate,
+                static_accel: self.static_accel,
+                magnetic_fraction: self.mag_threshold,
+                window_ns: ms_to_ns("window", self.window)?,
+            },
+        };
+        let eval = margemu::evaluate::evaluate(&source, &options)?;
+        print!("{}", report::summary(&eval));
+        let out = self.out.unwrap_or(default_out);
+        let written = report::write(&eval, &out, !self.no_plots)?;
+        let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+        println!("wrote {}", names.join(", "));
+        Ok(())
+    }
+}

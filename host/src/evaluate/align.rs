@@ -1,0 +1,232 @@
+//! Aligning a device's output with the truth: its latency, and its clock against the host's.
+//!
+//! **Latency** ([`estimate_latency`]): the shift `L` of the estimates' time stamps that
+//! minimises the mean squared geodesic error `c(L) = mean_j g(q(t_j − L), q̂_j)²`, with the
+//! truth interpolated as in [`score`](mod@super::score). The truth is noise-free, so `c` is smooth
+//! in `L` and a fractional shift does not average the estimates' noise away (interpolating
+//! noisy estimates would favour half-sample shifts). A coarse scan covers
+//! `[−max_lag, +max_lag]` in steps of the truth's sample period, on at most about 2000
+//! estimates (and only at lags where at least half as many overlap as at the best overlapping
+//! lag); a golden-section search over the two steps around the coarse minimum, on every
+//! estimate, refines it to 100 ns. `L` is the whole delay from the instant a sample
+//! describes to the time stamp its estimate carries: transport, the filter's processing and its
+//! own phase lag alike. Motion is what makes `L` observable: when the lowest cost is not at least
+//! 20 % below the median cost of the scan (a plate at rest, say), the estimate is reported as
+//! not observable and callers use 0. Keep `max_lag` below half the period of any periodic motion,
+//! or a whole period's shift fits as well as the true one.
+//!
+//! **Clock** ([`fit_clock`]): when the device stamps its output with its own clock, a least
+//! squares line `host_ns = offset + rate · device_time_us` through (device time, host arrival
+//! time) pairs gives the device clock's offset (the host time, on the scene's origin, at which
+//! the device clock read 0), its drift `(rate/1000 − 1)·10⁶` ppm, and the residual (how much the
+//! arrival times jitter about the line).
+
+use super::score::{Estimates, Reference, ScoreOptions};
+
+/// Where and how finely the latency is searched.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LatencySearch {
+    /// Largest lag tried either way (ns).
+    pub max_lag_ns: u64,
+    /// Coarse step (ns); `None`: the truth's median sample period.
+    pub step_ns: Option<u64>,
+    /// Warm-up and largest interpolation gap, as in scoring (`latency_ns` is ignored).
+    pub score: ScoreOptions,
+}
+
+impl Default for LatencySearch {
+    fn default() -> Self {
+        Self {
+            max_lag_ns: 500_000_000,
+            step_ns: None,
+            score: ScoreOptions::default(),
+        }
+    }
+}
+
+/// The result of a latency search.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Latency {
+    /// The best lag (ns): estimates stamped `t` describe the truth at `t − lag_ns`.
+    pub lag_ns: i64,
+    /// Mean squared geodesic error at that lag (rad²).
+    pub cost: f64,
+    /// `1 − cost / median cost of the scan`: how sharply the motion pins the lag.
+    pub contrast: f64,
+    /// Whether the contrast is at least [`MIN_CONTRAST`] and the minimum is inside the range.
+    pub observable: bool,
+    /// Whether the coarse minimum sat at an end of the range (raise the range).
+    pub at_edge: bool,
+    /// The coarse scan: `(lag ns, cost rad²)`.
+    pub curve: Vec<(i64, f64)>,
+}
+
+/// Smallest contrast for which a latency estimate is trusted.
+pub const MIN_CONTRAST: f64 = 0.2;
+
+/// Estimates used by the coarse scan, at most about this many.
+const COARSE_POINTS: usize = 2000;
+
+/// The latency of `estimates` against `reference` (see the module docs); `None` when no lag
+/// in the range overlaps the truth at all.
+pub fn estimate_latency(
+    reference: &Reference,
+    estimates: &Estimates,
+    search: &LatencySearch,
+) -> Option<Latency> {
+    let step = search.step_ns.unwrap_or(reference.median_step_ns()).max(1) as i64;
+    let stride = estimates.len().div_ceil(COARSE_POINTS).max(1);
+    let max = search.max_lag_ns as i64;
+    let cost = |lag: i64, stride: usize| {
+        let opts = ScoreOptions {
+            latency_ns: lag,
+            ..search.score
+        };
+        reference.geodesic_cost(estimates, &opts, stride)
+    };
+    let n_steps = max / step;
+    let scan: Vec<(i64, f64, usize)> = (-n_steps..=n_steps)
+        .filter_map(|i| cost(i * step, stride).map(|(c, n)| (i * step, c, n)))
+        .collect();
+    let most = scan.iter().map(|s| s.2).max()?;
+    let curve: Vec<(i64, f64)> = scan
+        .iter()
+        .filter(|s| 2 * s.2 >= most)
+        .map(|s| (s.0, s.1))
+        .collect();
+    let (best_i, &(coarse, _)) = curve
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))?;
+    let at_edge = best_i == 0 || best_i + 1 == curve.len();
+    let full = |lag: i64| cost(lag, 1).map_or(f64::INFINITY, |c| c.0);
+    let refined = golden_min(
+        |lag| full(lag.round() as i64),
+        (coarse - step) as f64,
+        (coarse + step) as f64,
+        100.0,
+    )
+    .round() as i64;
+    let (lag_ns, best) = [(refined, full(refined)), (coarse, full(coarse))]
+        .into_iter()
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    let mut costs: Vec<f64> = curve.iter().map(|c| c.1).collect();
+    costs.sort_by(f64::total_cmp);
+    let median = costs[costs.len() / 2];
+    let contrast = if median > 0.0 {
+        1.0 - best / median
+    } else {
+        0.0
+    };
+    Some(Latency {
+        lag_ns,
+        cost: best,
+        contrast,
+        observable: contrast >= MIN_CONTRAST && !at_edge,
+        at_edge,
+        curve,
+    })
+}
+
+/// The minimiser of `f` on `[lo, hi]` to within `tol`, by golden-section search.
+fn golden_min(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64, tol: f64) -> f64 {
+    let r = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut x1, mut x2) = (hi - r * (hi - lo), lo + r * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    while hi - lo > tol {
+        if f1 <= f2 {
+            hi = x2;
+            (x2, f2) = (x1, f1);
+            x1 = hi - r * (hi - lo);
+            f1 = f(x1);
+        } else {
+            lo = x1;
+            (x1, f1) = (x2, f2);
+            x2 = lo + r * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    (lo + hi) / 2.0
+}
+
+/// A device clock against the host's (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClockFit {
+    /// Host time (ns, scene origin) at which the device clock read 0.
+    pub offset_ns: f64,
+    /// Host nanoseconds per device microsecond (1000 for a perfect clock).
+    pub rate: f64,
+    /// `(rate / 1000 − 1) · 10⁶`: how fast the host clock runs against the device's (ppm);
+    /// positive when the device clock is slow.
+    pub drift_ppm: f64,
+    /// RMS of the host times about the line (ns).
+    pub residual_rms_ns: f64,
+    /// Largest distance of a host time from the line (ns).
+    pub residual_max_ns: f64,
+    /// Pairs fitted.
+    pub points: usize,
+}
+
+impl ClockFit {
+    /// The host time (ns, scene origin) of a device time (µs).
+    pub fn host_ns(&self, device_us: f64) -> f64 {
+        self.offset_ns + self.rate * device_us
+    }
+}
+
+/// The least squares line through `(device time µs, host time ns)` pairs; `None` with fewer
+/// than two distinct device times.
+pub fn fit_clock(pairs: &[(f64, f64)]) -> Option<ClockFit> {
+    let n = pairs.len() as f64;
+    let mean_d = pairs.iter().map(|p| p.0).sum::<f64>() / n;
+    let mean_h = pairs.iter().map(|p| p.1).sum::<f64>() / n;
+    let sdd: f64 = pairs.iter().map(|p| (p.0 - mean_d).powi(2)).sum();
+    let sdh: f64 = pairs.iter().map(|p| (p.0 - mean_d) * (p.1 - mean_h)).sum();
+    if pairs.len() < 2 || sdd <= 0.0 || !sdd.is_finite() {
+        return None;
+    }
+    let rate = sdh / sdd;
+    let offset_ns = mean_h - rate * mean_d;
+    let fit = ClockFit {
+        offset_ns,
+        rate,
+        drift_ppm: (rate / 1000.0 - 1.0) * 1e6,
+        residual_rms_ns: 0.0,
+        residual_max_ns: 0.0,
+        points: pairs.len(),
+    };
+    let residuals = pairs.iter().map(|p| p.1 - fit.host_ns(p.0));
+    let sum_sq: f64 = residuals.clone().map(|r| r * r).sum();
+    Some(ClockFit {
+        residual_rms_ns: (sum_sq / n).sqrt(),
+        residual_max_ns: residuals.fold(0.0, |m, r| m.max(r.abs())),
+        ..fit
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn golden_section_finds_a_parabola_minimum() {
+        let x = golden_min(|x| (x - 3.7e6).powi(2), 0.0, 1e7, 10.0);
+        assert!((x - 3.7e6).abs() < 10.0, "{x}");
+    }
+
+    #[test]
+    fn clock_fit_recovers_offset_and_drift() {
+        let pairs: Vec<(f64, f64)> = (0..1000)
+            .map(|k| {
+                let d = 5e6 + k as f64 * 1000.0;
+                (d, -2.5e9 + d * 1000.0 * (1.0 + 80e-6))
+            })
+            .collect();
+        let fit = fit_clock(&pairs).unwrap();
+        assert!((fit.drift_ppm - 80.0).abs() < 1e-6, "{fit:?}");
+        assert!((fit.offset_ns + 2.5e9).abs() < 1e-3, "{fit:?}");
+        assert!(fit.residual_max_ns < 1e-3);
+        assert!(fit_clock(&[(1.0, 2.0)]).is_none());
+        assert!(fit_clock(&[(1.0, 2.0), (1.0, 3.0)]).is_none());
+    }
+}

@@ -1,0 +1,165 @@
+//! Splitting a run into phases, so each can be scored on its own: static, dynamic and magnetic
+//! perturbation (the conditions the paper's Figures 8–10 show in their last two rows).
+//!
+//! Rules, per truth instant, from three magnitudes ([`PhaseSample`]):
+//!
+//! 1. **magnetic**: the field deviates from its reference by more than
+//!    [`PhaseRules::magnetic_fraction`] of the reference's norm at some instant within half a
+//!    [`PhaseRules::window_ns`] (a burst's waveform passes through zero inside the burst, and a
+//!    filter feels it beyond its edges);
+//! 2. else **static**: the body rate is below [`PhaseRules::static_rate`] *and* the external
+//!    acceleration below [`PhaseRules::static_accel`];
+//! 3. else **dynamic**.
+//!
+//! Where the magnitudes come from is the caller's business ([`super::run`], [`super::signals`]): the truth's
+//! body rate and external acceleration when there is a truth; the perturbation a simulation
+//! added (`perturbation.csv`), or the measured field minus the true field, or (for an external
+//! recording) the measured field's norm minus its median norm. Measured signals are noisy, so
+//! they are averaged over [`PhaseRules::window_ns`] (each axis, or the signed norm deviation)
+//! before the magnitude is taken ([`moving_mean`]).
+
+/// The phase of one instant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Phase {
+    /// At rest: slow rotation and no external acceleration.
+    Static,
+    /// Moving.
+    Dynamic,
+    /// Under a magnetic perturbation (whatever the motion).
+    Magnetic,
+}
+
+impl Phase {
+    /// All phases, in report order.
+    pub const ALL: [Self; 3] = [Self::Static, Self::Dynamic, Self::Magnetic];
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Static => "static",
+            Self::Dynamic => "dynamic",
+            Self::Magnetic => "magnetic",
+        }
+    }
+}
+
+/// Thresholds of the phase rules.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhaseRules {
+    /// Body rate below which the plate may be static (rad/s).
+    pub static_rate: f64,
+    /// External acceleration below which the plate may be static (m/s²).
+    pub static_accel: f64,
+    /// Field deviation, as a fraction of the reference norm, above which the field is perturbed.
+    pub magnetic_fraction: f64,
+    /// Averaging window of measured (noisy) signals (ns).
+    pub window_ns: u64,
+}
+
+impl Default for PhaseRules {
+    /// 0.05 rad/s, 0.1 m/s², 10 % of the field, 100 ms.
+    fn default() -> Self {
+        Self {
+            static_rate: 0.05,
+            static_accel: 0.1,
+            magnetic_fraction: 0.1,
+            window_ns: 100_000_000,
+        }
+    }
+}
+
+/// The magnitudes the rules look at, for one instant.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhaseSample {
+    /// Body rate (rad/s).
+    pub rate: f64,
+    /// External acceleration (m/s²).
+    pub accel: f64,
+    /// Field deviation as a fraction of the reference norm.
+    pub field: f64,
+}
+
+/// The phase of every sample, `step_ns` apart.
+pub fn classify(samples: &[PhaseSample], rules: &PhaseRules, step_ns: u64) -> Vec<Phase> {
+    let half = (rules.window_ns / 2 / step_ns.max(1)) as usize;
+    let perturbed: Vec<[f64; 1]> = samples
+        .iter()
+        .map(|s| [f64::from(u8::from(s.field > rules.magnetic_fraction))])
+        .collect();
+    // A mean above zero over the window: some instant in it is perturbed.
+    let near = moving_mean(&perturbed, half);
+    samples
+        .iter()
+        .zip(near)
+        .map(|(s, near)| {
+            if near[0] > 0.0 {
+                Phase::Magnetic
+            } else if s.rate < rules.static_rate && s.accel < rules.static_accel {
+                Phase::Static
+            } else {
+                Phase::Dynamic
+            }
+        })
+        .collect()
+}
+
+/// Centred moving mean of each component over `2·half + 1` samples (fewer at the ends).
+pub fn moving_mean<const N: usize>(values: &[[f64; N]], half: usize) -> Vec<[f64; N]> {
+    let mut prefix = vec![[0.0; N]; values.len() + 1];
+    for (i, v) in values.iter().enumerate() {
+        prefix[i + 1] = core::array::from_fn(|j| prefix[i][j] + v[j]);
+    }
+    (0..values.len())
+        .map(|i| {
+            let (lo, hi) = (i.saturating_sub(half), (i + half + 1).min(values.len()));
+            core::array::from_fn(|j| (prefix[hi][j] - prefix[lo][j]) / (hi - lo) as f64)
+        })
+        .collect()
+}
+
+/// Runs of equal phase: `(phase, first index, last index)`.
+pub fn runs(phases: &[Phase]) -> Vec<(Phase, usize, usize)> {
+    let mut out: Vec<(Phase, usize, usize)> = Vec::new();
+    for (i, &p) in phases.iter().enumerate() {
+        match out.last_mut() {
+            Some(run) if run.0 == p => run.2 = i,
+            _ => out.push((p, i, i)),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn magnetic_wins_then_static_needs_both_quiet() {
+        let rules = PhaseRules::default();
+        let s = |rate, accel, field| PhaseSample { rate, accel, field };
+        let samples = [
+            s(0.0, 0.0, 0.0),
+            s(0.2, 0.0, 0.0),
+            s(0.0, 0.5, 0.0),
+            s(0.0, 0.0, 0.3),
+        ];
+        // Samples 1 s apart: the 100 ms window reaches no neighbour.
+        let phases = classify(&samples, &rules, 1_000_000_000);
+        use Phase::*;
+        assert_eq!(phases, [Static, Dynamic, Dynamic, Magnetic]);
+        assert_eq!(
+            runs(&phases),
+            [(Static, 0, 0), (Dynamic, 1, 2), (Magnetic, 3, 3)]
+        );
+        // 20 ms apart: the perturbation at sample 3 marks the two before it too.
+        let phases = classify(&samples, &rules, 20_000_000);
+        assert_eq!(phases, [Static, Magnetic, Magnetic, Magnetic]);
+    }
+
+    #[test]
+    fn moving_mean_averages_a_centred_window() {
+        let v: Vec<[f64; 1]> = [1.0, 2.0, 3.0, 4.0, 5.0].iter().map(|&x| [x]).collect();
+        let m = moving_mean(&v, 1);
+        assert_eq!(m, [[1.5], [2.0], [3.0], [4.0], [4.5]]);
+    }
+}
