@@ -49,7 +49,7 @@ const RX_CHUNK: usize = 256;
 /// Received bytes that wake the loop body before the tick does.
 const RX_BATCH: usize = 64;
 /// The wake-up tick's period: a sample instant is served at most this late. Each tick costs
-/// QEMU ~40 µs of host time (measured: an idle board takes 5 % of a core at 1 ms, 20 % at
+/// QEMU ~50 µs of host time (measured: an idle board takes 5 % of a core at 1 ms, 20 % at
 /// 250 µs).
 const TICK_NS: u32 = 1_000_000;
 
