@@ -1,29 +1,26 @@
 //! The embedded default: the firmware library's link handler ([`Device`]) running on the host,
 //! behind a real pseudo-terminal pair, so a scene streams exactly as to a board.
 //!
-//! [`spawn_device`] starts the device on one end of a `TTYPort::pair()` in a thread: it reads
-//! what arrives, feeds it to [`Device::feed`] with the time of a monotonic clock, and writes what
-//! [`Device::poll`] sends. It also decodes the `Served` reports it sends itself (the CRC-32C of
-//! every image it latched into the emulated chip), so the caller can check byte for byte that
-//! what the device served is what the host predicted. The host side is an ordinary
-//! [`Session`](crate::stream::Session) on the other end.
+//! [`spawn_device`] starts the device on one end of a `TTYPort::pair()` in a thread. Each turn
+//! of its loop reads what arrived (1 ms timeout), serves the sample instants that are due
+//! ([`Device::poll`], as a board's timer interrupt would, before acting on the bytes), feeds the
+//! bytes ([`Device::feed`]) and polls again, writing every frame the device sends, on a
+//! monotonic clock. The host side is an ordinary [`Session`](crate::stream::Session) on the
+//! other end; it checks the device's own Served reports against its prediction.
 
-use margemu_firmware::link::Device;
-use margemu_protocol::link::{Accumulator, FeedResult, FrameRepr, Message};
+use margemu_firmware::link::{Counters, Device};
 use serialport::{SerialPort, TTYPort};
-use std::io::{ErrorKind, Read, Write};
+use std::io::{Read, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-/// What the loopback device saw and served.
+/// What the loopback device counted, and why it ended.
 #[derive(Clone, Debug, Default)]
 pub struct DeviceReport {
-    /// `(sample index, CRC-32C of the image served, underrun)` of every instant served.
-    pub served: Vec<(u64, u32, bool)>,
-    /// Samples served, underruns and overruns, as the device counted them.
-    pub counters: (u64, u64, u64),
+    /// The device's counters at the end (served, underruns, overruns, receive errors).
+    pub counters: Counters,
     /// Why the device loop ended (stop flag, end of file, or a port error).
     pub ended: String,
 }
@@ -35,7 +32,7 @@ pub struct LoopbackDevice {
 }
 
 impl LoopbackDevice {
-    /// Stops the device loop and returns what it served.
+    /// Stops the device loop and returns its report.
     pub fn stop(self) -> DeviceReport {
         self.stop.store(true, Ordering::Relaxed);
         self.thread.join().unwrap_or_else(|_| DeviceReport {
@@ -54,73 +51,48 @@ pub fn spawn_device(mut port: TTYPort) -> std::io::Result<LoopbackDevice> {
         .name("loopback-device".into())
         .spawn(move || {
             let mut device: Box<Device> = Box::default();
-            let mut sniffer = ServedSniffer::default();
             let origin = Instant::now();
-            let mut buf = vec![0u8; 4096];
             let now = || origin.elapsed().as_nanos() as u64;
+            let mut buf = vec![0u8; 4096];
             let ended = loop {
                 if flag.load(Ordering::Relaxed) {
                     break "stopped".to_owned();
                 }
-                match port.read(&mut buf) {
+                let n = match port.read(&mut buf) {
                     Ok(0) => break "end of file".to_owned(),
-                    Ok(n) => device.feed(&buf[..n], now()),
-                    Err(e)
-                        if matches!(
-                            e.kind(),
-                            ErrorKind::TimedOut | ErrorKind::WouldBlock | ErrorKind::Interrupted
-                        ) => {}
+                    Ok(n) => n,
+                    Err(e) if crate::stream::rx::is_transient(&e) => 0,
                     Err(e) => break format!("port error: {e}"),
-                }
-                let mut write_error = None;
-                device.poll(now(), &mut |frame: &[u8]| {
-                    sniffer.observe(frame);
-                    if write_error.is_none() {
-                        write_error = port.write_all(frame).err();
-                    }
-                });
-                if let Some(e) = write_error {
+                };
+                if let Err(e) = serve(&mut device, &mut port, &buf[..n], now()) {
                     break format!("port error: {e}");
                 }
             };
-            let c = device.counters();
             DeviceReport {
-                served: sniffer.served,
-                counters: (c.served, u64::from(c.underruns), u64::from(c.overruns)),
+                counters: *device.counters(),
                 ended,
             }
         })?;
     Ok(LoopbackDevice { stop, thread })
 }
 
-/// Decodes the device's own outgoing frames and keeps its `Served` reports.
-#[derive(Default)]
-struct ServedSniffer {
-    accumulator: Accumulator,
-    served: Vec<(u64, u32, bool)>,
-}
-
-impl ServedSniffer {
-    fn observe(&mut self, wire: &[u8]) {
-        let mut rest = wire;
-        while !rest.is_empty() {
-            match self.accumulator.feed(rest) {
-                FeedResult::Consumed => break,
-                FeedResult::Success { frame, remaining } => {
-                    if let Ok(FrameRepr {
-                        message: Message::Served(batch),
-                        ..
-                    }) = FrameRepr::parse(&frame)
-                    {
-                        for (k, s) in batch.samples.iter().enumerate() {
-                            self.served
-                                .push((batch.first_index + k as u64, s.crc32c, s.underrun));
-                        }
-                    }
-                    rest = remaining;
-                }
-                other => rest = other.remaining(),
-            }
+/// One turn of the device loop at local time `now_ns`: serve what is due, take `input`, send.
+fn serve(
+    device: &mut Device,
+    port: &mut impl Write,
+    input: &[u8],
+    now_ns: u64,
+) -> std::io::Result<()> {
+    let mut result = Ok(());
+    let mut tx = |frame: &[u8]| {
+        if result.is_ok() {
+            result = port.write_all(frame);
         }
+    };
+    device.poll(now_ns, &mut tx);
+    if !input.is_empty() {
+        device.feed(input, now_ns);
+        device.poll(now_ns, &mut tx);
     }
+    result
 }

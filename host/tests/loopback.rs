@@ -26,6 +26,7 @@ fn loopback(scene_text: &str, name: &str) -> String {
         "meta.toml",
         "truth.csv",
         "sent.csv",
+        "served.csv",
         "device.csv",
         "telemetry.csv",
         "events.csv",
@@ -33,6 +34,17 @@ fn loopback(scene_text: &str, name: &str) -> String {
         assert!(dir.join("session").join(log).exists(), "{log} missing");
     }
     stdout
+}
+
+/// Every row of `served.csv` of the session in `dir` (after its header, checked).
+fn served_rows(name: &str) -> Vec<Vec<String>> {
+    let dir = std::env::temp_dir().join(format!("margemu-loopback-{}-{name}", std::process::id()));
+    let text = std::fs::read_to_string(dir.join("session/served.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(margemu::stream::log::SERVED_COLUMNS));
+    lines
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect()
 }
 
 #[test]
@@ -50,6 +62,15 @@ fn every_sample_is_served_and_confirmed_byte_for_byte() {
         out.contains("1000 of 1000 predicted images confirmed byte for byte"),
         "{out}"
     );
+    // served.csv: one row per instant, in order, at the scheduled instant, each a match.
+    let rows = served_rows("1khz");
+    assert_eq!(rows.len(), 1000);
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row[1], k.to_string());
+        assert_eq!(row[2], (k * 1_000_000).to_string(), "device time of {k}");
+        assert_eq!(row[3].len(), 8);
+        assert_eq!(&row[4..], ["0", "0", "1"], "sample {k}");
+    }
 }
 
 #[test]

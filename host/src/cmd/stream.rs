@@ -117,6 +117,11 @@ pub fn stream_to(
         t.map_or(0, |t| t.crc_errors),
         summary.host_rx.crc_errors + summary.host_rx.framing_errors,
     );
+    let s = summary.served;
+    println!(
+        "served as predicted, byte for byte: {} of {} samples ({} underruns, {} mismatched, {} not reported; served.csv)",
+        s.byte_exact, s.samples, s.underruns, s.mismatched, s.unreported
+    );
     let j = summary.jitter;
     println!(
         "pacing jitter over {} batches: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; logs in {}",
@@ -140,7 +145,9 @@ fn show(bar: &ProgressBar, p: &Progress) {
         0.0
     };
     bar.set_message(format!(
-        "| {rate:.0} samples/s served | underruns {} | CRC errors dev {} host {} | jitter {:.0} µs (max {:.0})",
+        "| {rate:.0} samples/s served | {} byte-exact, {} mismatched | underruns {} | CRC errors dev {} host {} | jitter {:.0} µs (max {:.0})",
+        p.served.byte_exact,
+        p.served.mismatched,
         t.map_or(0, |t| t.underruns),
         t.map_or(0, |t| t.crc_errors),
         p.host_rx.crc_errors,

@@ -10,6 +10,7 @@
 //! |---|---|
 //! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample of the scene |
 //! | `sent.csv` | `index,t_ns,send_ns,late_ns,image`: sample index, its latch instant, when its batch was written to the port, how late that write was against its schedule `start_host_ns + t_ns − lead` for the batch's first sample (empty for the prefill, written before Start), and the 22-byte register image as 44 lowercase hex digits |
+//! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before`: each write of the device under test (`bus` spi, i2c or aux; `dropped_before`: writes the device lost just before this batch) |
@@ -17,7 +18,7 @@
 
 use crate::output::TruthWriter;
 use crate::truth::Truth;
-use margemu_protocol::link::{Bus, Image, RegisterWrite, Telemetry};
+use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -26,6 +27,8 @@ use super::images::image_hex;
 
 /// Header of `sent.csv`.
 pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image";
+/// Header of `served.csv`.
+pub const SERVED_COLUMNS: &str = "host_ns,index,time_ns,crc32c,underrun,empty,match";
 /// Header of `device.csv`.
 pub const DEVICE_COLUMNS: &str =
     "host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns";
@@ -41,6 +44,7 @@ pub const EVENTS_COLUMNS: &str = "host_ns,event,detail";
 pub struct SessionLog {
     dir: PathBuf,
     sent: BufWriter<File>,
+    served: BufWriter<File>,
     device: BufWriter<File>,
     telemetry: BufWriter<File>,
     register_writes: BufWriter<File>,
@@ -61,6 +65,7 @@ impl SessionLog {
         let mut log = Self {
             dir: dir.to_path_buf(),
             sent: create(dir, "sent.csv", SENT_COLUMNS)?,
+            served: create(dir, "served.csv", SERVED_COLUMNS)?,
             device: create(dir, "device.csv", DEVICE_COLUMNS)?,
             telemetry: create(dir, "telemetry.csv", TELEMETRY_COLUMNS)?,
             register_writes: create(dir, "register_writes.csv", REGISTER_WRITES_COLUMNS)?,
@@ -99,6 +104,25 @@ impl SessionLog {
             self.sent,
             "{index},{t_ns},{send_ns},{late},{}",
             image_hex(image)
+        )
+    }
+
+    /// One row of `served.csv`; `matches` is `None` after the scene's last sample.
+    pub fn served(
+        &mut self,
+        host_ns: i64,
+        index: u64,
+        time_ns: u64,
+        entry: &ServedSample,
+        matches: Option<bool>,
+    ) -> io::Result<()> {
+        let matches = matches.map_or("", |m| if m { "1" } else { "0" });
+        writeln!(
+            self.served,
+            "{host_ns},{index},{time_ns},{:08x},{},{},{matches}",
+            entry.crc32c,
+            u8::from(entry.underrun),
+            u8::from(entry.empty)
         )
     }
 
@@ -178,6 +202,7 @@ impl SessionLog {
     /// Flushes every file to the operating system.
     pub fn flush(&mut self) -> io::Result<()> {
         self.sent.flush()?;
+        self.served.flush()?;
         self.device.flush()?;
         self.telemetry.flush()?;
         self.register_writes.flush()?;

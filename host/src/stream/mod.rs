@@ -17,21 +17,27 @@
 //! 5. after the last sample's instant: wait for Telemetry saying it was served, Stop, and wait for
 //!    Telemetry in the stopped state.
 //!
-//! A receive thread ([`rx`]) decodes Credit, Telemetry, RegisterWrites, Reset and Error frames
-//! concurrently and counts damaged frames. The session stops with a [`StreamError`] on a device
+//! A receive thread ([`rx`]) decodes the device's frames concurrently and counts damaged ones.
+//! Every sample instant the device reports serving (its Served messages: index, CRC-32C of the
+//! image latched) is logged in `served.csv` and checked against the prediction ([`served`]); the
+//! [`Summary`] carries the counts. The session stops with a [`StreamError`] on a device
 //! Reset after the handshake, a fatal device Error, end of file or an error on the port, a
 //! timeout waiting for HelloAck or credit, or the stop flag (Ctrl-C); in every case the logs
 //! ([`log`]) are flushed and end with an `end` row in `events.csv`.
 //!
 //! [`ImageRepr::from_physical`]: margemu_protocol::regmap::image::ImageRepr::from_physical
 
+mod flow;
 pub mod images;
 pub mod log;
 mod meta;
+mod pacing;
 pub mod rx;
+pub mod served;
 mod session;
 
 pub use images::{image_hex, parse_image_hex, predict, ImageSettings, PredictedSample};
+pub use served::{ServedCheck, ServedStats};
 pub use session::{rate_of, Session, StreamConfig, WHO_AM_I};
 
 use margemu_protocol::link::{HelloAck, RxStats, Telemetry};
@@ -122,6 +128,8 @@ pub struct Progress {
     pub last_late_ns: i64,
     /// The latest batch so far, ns.
     pub max_late_ns: i64,
+    /// What the device reported serving so far, against the prediction.
+    pub served: ServedStats,
 }
 
 /// Pacing jitter: how late each batch was written against its schedule, over the batches
@@ -180,6 +188,8 @@ pub struct Summary {
     pub host_rx: RxStats,
     /// Times a due batch had to wait for credit.
     pub credit_stalls: u64,
+    /// What the device reported serving, against the prediction (`served.csv`).
+    pub served: ServedStats,
     /// The register settings of the images.
     pub image_settings: ImageSettings,
     /// Time from Start to the end.

@@ -1,0 +1,169 @@
+//! Pacing: the prefill, the batches written in real time on the host's monotonic clock within
+//! the device's credit window, and the Stop after the last sample's instant.
+
+use super::flow::Run;
+use super::Progress;
+use super::StreamError;
+use margemu_protocol::link::{
+    DeviceState, Image, ImageBatch, Message, Start, MAX_IMAGES_PER_BATCH,
+};
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
+    fn batch_len(&self) -> u64 {
+        let device = self
+            .ack
+            .map_or(1, |a| usize::from(a.capabilities.max_batch));
+        self.session
+            .config
+            .batch
+            .min(device)
+            .clamp(1, MAX_IMAGES_PER_BATCH) as u64
+    }
+
+    /// The instant the batch starting at sample `k` is due (`None` before Start).
+    fn due(&self, k: u64) -> Option<Instant> {
+        let t = Duration::from_nanos(self.session.rate.sample_time_ns(k));
+        let start = self.start?;
+        Some(
+            (start + t)
+                .checked_sub(self.session.config.lead)
+                .unwrap_or(start)
+                .max(start),
+        )
+    }
+
+    fn write_batch(
+        &mut self,
+        n: u64,
+        late_ns: Option<i64>,
+        paced: bool,
+    ) -> Result<(), StreamError> {
+        let first = self.next;
+        let range = first as usize..(first + n) as usize;
+        let images: Vec<Image> = self.session.samples[range.clone()]
+            .iter()
+            .map(|s| s.image)
+            .collect();
+        self.send(&Message::Images(ImageBatch::new(first, &images)))?;
+        let send_ns = self.host_ns(Instant::now());
+        if let (Some(l), true) = (late_ns, paced) {
+            self.late.push(l);
+            self.max_late_ns = self.max_late_ns.max(l);
+        }
+        for (i, s) in self.session.samples[range].iter().enumerate() {
+            let k = first + i as u64;
+            let r = self
+                .session
+                .log
+                .sent(k, s.truth.t_ns, send_ns, late_ns, &s.image);
+            r.map_err(self.log_err())?;
+        }
+        self.next += n;
+        let r = self.session.log.flush();
+        r.map_err(self.log_err())
+    }
+
+    pub(super) fn stream(&mut self) -> Result<(), StreamError> {
+        let total = self.total();
+        let batch = self.batch_len();
+        let lead_ns = self.session.config.lead.as_nanos() as u64;
+        // Prefill: every sample due at Start, within the first window.
+        while self.next < total
+            && self.session.rate.sample_time_ns(self.next) <= lead_ns
+            && self.credit.available(self.next) > 0
+        {
+            let n = batch
+                .min(self.credit.available(self.next))
+                .min(total - self.next);
+            self.write_batch(n, None, false)?;
+        }
+        self.send(&Message::Start(Start { t0_ns: 0 }))?;
+        let start = Instant::now();
+        self.start = Some(start);
+        let start_ns = self.host_ns(start);
+        self.event(
+            "start",
+            &format!("start_host_ns {start_ns}; prefill {}", self.next),
+        )?;
+        let mut stall: Option<Instant> = None;
+        while self.next < total {
+            self.report(false);
+            let due = self.due(self.next).expect("started");
+            let now = Instant::now();
+            if now + self.session.config.spin < due {
+                self.pump(due - self.session.config.spin)?;
+                continue;
+            }
+            while Instant::now() < due {
+                std::hint::spin_loop();
+            }
+            while let Ok(event) = self.events.try_recv() {
+                self.handle(event)?;
+            }
+            let available = self.credit.available(self.next);
+            if available == 0 {
+                let since = *stall.get_or_insert_with(|| {
+                    self.credit_stalls += 1;
+                    Instant::now()
+                });
+                let limit = since + self.session.config.credit_timeout;
+                if Instant::now() >= limit {
+                    return Err(StreamError::CreditTimeout {
+                        index: self.next,
+                        timeout: self.session.config.credit_timeout,
+                    });
+                }
+                self.pump(limit)?;
+                continue;
+            }
+            // A batch held back by the credit window is late because of the device, not of
+            // the pacing: logged, but left out of the jitter figures.
+            let paced = stall.take().is_none();
+            let n = batch.min(available).min(total - self.next);
+            let late = Instant::now().saturating_duration_since(due).as_nanos() as i64;
+            self.write_batch(n, Some(late), paced)?;
+        }
+        Ok(())
+    }
+
+    /// Sends Stop half a period after the last sample's instant (so the device serves it and
+    /// no instant after it), then waits for Telemetry in the stopped state.
+    pub(super) fn finish(&mut self) -> Result<(), StreamError> {
+        let total = self.total();
+        let drain = self.session.config.drain_timeout;
+        if let (Some(start), Some(last)) = (self.start, total.checked_sub(1)) {
+            let rate = self.session.rate;
+            let (t_last, t_next) = (rate.sample_time_ns(last), rate.sample_time_ns(total));
+            let stop_at = start + Duration::from_nanos(t_last + (t_next - t_last) / 2);
+            while Instant::now() + self.session.config.spin < stop_at {
+                self.report(false);
+                self.pump(stop_at - self.session.config.spin)?;
+            }
+            while Instant::now() < stop_at {
+                std::hint::spin_loop();
+            }
+        }
+        self.send(&Message::Stop)?;
+        let deadline = Instant::now() + drain;
+        while Instant::now() < deadline
+            && !self
+                .telemetry
+                .is_some_and(|t| t.state == DeviceState::Stopped)
+        {
+            self.pump(deadline)?;
+        }
+        self.report(true);
+        match self.telemetry {
+            Some(t) if t.state == DeviceState::Stopped => {
+                let detail = format!(
+                    "served {} samples, last index {}, underruns {}",
+                    t.samples_served, t.last_served_index, t.underruns
+                );
+                self.event("stopped", &detail)
+            }
+            _ => self.event("stop_unconfirmed", "no Telemetry in the stopped state"),
+        }
+    }
+}
