@@ -1,6 +1,10 @@
 //! The embedded default: the firmware library's link handler ([`Device`]) running on the host,
 //! behind a real pseudo-terminal pair, so a scene streams exactly as to a board.
 //!
+//! The device buffers [`BUFFER`] samples: more than the QEMU board's 128, as a board with a few
+//! tens of KB of RAM to spare would, so that the host's scheduling hiccups on a busy machine
+//! (several ms) stay well inside the lead at 8 kHz and beyond.
+//!
 //! [`spawn_device`] starts the device on one end of a `TTYPort::pair()` in a thread. Each turn
 //! of its loop reads what arrived (1 ms timeout), serves the sample instants that are due
 //! ([`Device::poll`], as a board's timer interrupt would, before acting on the bytes), feeds the
@@ -15,6 +19,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
+
+/// Samples the loopback device buffers (its credit window).
+pub const BUFFER: usize = 1024;
+
+/// The loopback device: the firmware's link handler with a [`BUFFER`]-sample window.
+pub type Firmware = Device<BUFFER>;
 
 /// What the loopback device counted, and why it ended.
 #[derive(Clone, Debug, Default)]
@@ -50,7 +60,7 @@ pub fn spawn_device(mut port: TTYPort) -> std::io::Result<LoopbackDevice> {
     let thread = std::thread::Builder::new()
         .name("loopback-device".into())
         .spawn(move || {
-            let mut device: Box<Device> = Box::default();
+            let mut device: Box<Firmware> = Box::default();
             let origin = Instant::now();
             let now = || origin.elapsed().as_nanos() as u64;
             let mut buf = vec![0u8; 4096];
@@ -78,7 +88,7 @@ pub fn spawn_device(mut port: TTYPort) -> std::io::Result<LoopbackDevice> {
 
 /// One turn of the device loop at local time `now_ns`: serve what is due, take `input`, send.
 fn serve(
-    device: &mut Device,
+    device: &mut Firmware,
     port: &mut impl Write,
     input: &[u8],
     now_ns: u64,

@@ -2,7 +2,7 @@
 //! the host behind a real pseudo-terminal pair, the scene streams to it exactly as to a board,
 //! and every image the device reports serving is checked against the host's prediction.
 
-use super::stream::{prepare, stream_to};
+use super::stream::{prepare, stream_to, SourceArgs};
 use anyhow::{bail, Context, Result};
 use margemu::scene::Scene;
 use margemu::stream::{ImageSettings, StreamConfig};
@@ -16,6 +16,8 @@ pub struct Cmd {
     /// Session directory (default: sessions/<scene name>-loopback).
     #[arg(short, long)]
     output: Option<PathBuf>,
+    #[command(flatten)]
+    source: SourceArgs,
 }
 
 impl Cmd {
@@ -34,6 +36,7 @@ impl Cmd {
         let config = StreamConfig {
             port: label.clone(),
             images: Some(settings),
+            source: self.source.mode()?,
             ..StreamConfig::default()
         };
         let session = prepare(&scene, config, &dir)?;

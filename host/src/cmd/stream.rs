@@ -4,7 +4,7 @@
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use margemu::scene::Scene;
-use margemu::stream::{open_port, Progress, Session, StreamConfig};
+use margemu::stream::{open_port, Progress, Session, SourceMode, StreamConfig};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -21,8 +21,9 @@ pub struct Cmd {
     /// Session directory (default: sessions/<scene name>).
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Write each batch this many milliseconds before its first sample's instant.
-    #[arg(long, default_value_t = 20.0)]
+    /// Write each batch this many milliseconds before its first sample's instant (at most 3/8
+    /// of the device's buffer).
+    #[arg(long, default_value_t = 50.0)]
     lead_ms: f64,
     /// Most register images per batch.
     #[arg(long, default_value_t = 32)]
@@ -30,6 +31,45 @@ pub struct Cmd {
     /// µT per unit of the scene's field (default: 1 for µT scenes, 50 for normalized ones).
     #[arg(long)]
     mag_ut_per_unit: Option<f64>,
+    #[command(flatten)]
+    source: SourceArgs,
+}
+
+/// Where the device's samples come from.
+#[derive(clap::Args)]
+pub struct SourceArgs {
+    /// `images`: the host sends every register image; `model`: the host sends true kinematics
+    /// and the device runs the shared sensor model (scenes without a perturbation).
+    #[arg(long, value_enum, default_value_t = Source::Images)]
+    source: Source,
+    /// Kinematics rate for `--source model`, Hz: the output rate divided by a whole number
+    /// (default: the output rate / max(2, ceil(rate / 1000 Hz))).
+    #[arg(long, value_name = "HZ")]
+    kinematics_rate: Option<f64>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Source {
+    Images,
+    Model,
+}
+
+impl SourceArgs {
+    /// The library's source mode; a kinematics rate without `--source model` is an error.
+    pub fn mode(&self) -> Result<SourceMode> {
+        match self.source {
+            Source::Images => {
+                anyhow::ensure!(
+                    self.kinematics_rate.is_none(),
+                    "--kinematics-rate needs --source model"
+                );
+                Ok(SourceMode::Images)
+            }
+            Source::Model => Ok(SourceMode::Model {
+                kinematics_hz: self.kinematics_rate,
+            }),
+        }
+    }
 }
 
 impl Cmd {
@@ -52,6 +92,7 @@ impl Cmd {
             port: self.port.clone(),
             baud: self.baud,
             images: Some(images),
+            source: self.source.mode()?,
             lead: Duration::from_secs_f64(self.lead_ms / 1000.0),
             batch: self.batch.max(1),
             ..StreamConfig::default()
@@ -88,7 +129,7 @@ pub fn stream_to(
     let stop = session.stop_flag();
     ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
         .context("installing the Ctrl-C handler")?;
-    let bar = ProgressBar::new(scene.samples());
+    let bar = ProgressBar::new(session.samples().len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),
     );
@@ -106,9 +147,13 @@ pub fn stream_to(
     let summary = summary?;
     let t = summary.telemetry;
     println!(
-        "sent {}/{} samples in {:.2} s to {}; served {}, underruns {}, overruns {}, device CRC errors {}, host receive errors {}",
+        "sent {}/{} {} in {:.2} s to {}; served {}, underruns {}, overruns {}, device CRC errors {}, host receive errors {}",
         summary.sent,
-        summary.samples,
+        summary.stream_len,
+        match summary.source {
+            SourceMode::Images => "images",
+            SourceMode::Model { .. } => "kinematics samples",
+        },
         summary.elapsed.as_secs_f64(),
         label,
         t.map_or(0, |t| t.samples_served),
@@ -135,6 +180,7 @@ pub fn stream_to(
 }
 
 fn show(bar: &ProgressBar, p: &Progress) {
+    bar.set_length(p.total);
     bar.set_position(p.sent);
     let secs = p.elapsed.as_secs_f64();
     let t = p.telemetry;

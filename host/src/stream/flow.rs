@@ -5,11 +5,11 @@
 use super::meta::device_meta;
 use super::rx::{self, DeviceMessage, RxEvent};
 use super::served::ServedCheck;
-use super::session::{Session, WHO_AM_I};
-use super::{JitterStats, Progress, StreamError, Summary};
+use super::session::Session;
+use super::{JitterStats, LinkStats, Progress, StreamError, Summary};
 use margemu_protocol::link::{
-    Chips, Configure, Credit, Encoder, ErrorCode, ErrorReport, Hello, HelloAck, Message, Modes,
-    RxStats, ServedSample, Telemetry, CRC32C,
+    Chips, Credit, Encoder, ErrorCode, ErrorReport, Hello, HelloAck, Message, RxStats,
+    ServedSample, Telemetry, CRC32C,
 };
 use margemu_protocol::PROTOCOL_VERSION;
 use std::io::Write;
@@ -39,8 +39,13 @@ pub(super) struct Run<'s, W: Write, P: FnMut(&Progress)> {
     pub(super) late: Vec<i64>,
     pub(super) max_late_ns: i64,
     pub(super) credit_stalls: u64,
-    /// The next sample to write.
+    /// The next item to write.
     pub(super) next: u64,
+    /// Items per batch and lead, from the device's capabilities ([`Run::plan_pacing`]).
+    pub(super) batch: u64,
+    pub(super) lead: Duration,
+    /// Bytes written to the port: all, and those of sample batches with their item bytes.
+    pub(super) link: LinkStats,
     pub(super) progress: P,
     pub(super) last_progress: Instant,
 }
@@ -75,6 +80,9 @@ impl<'s, W: Write, P: FnMut(&Progress)> Run<'s, W, P> {
             max_late_ns: 0,
             credit_stalls: 0,
             next: 0,
+            batch: 1,
+            lead: Duration::ZERO,
+            link: LinkStats::default(),
             progress,
             last_progress: origin,
         }
@@ -121,8 +129,14 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             .encoder
             .encode(message, &mut self.wire)
             .expect("every message the host builds fits a frame");
+        self.write_wire(n)
+    }
+
+    /// Writes the first `len` bytes of the wire buffer (one encoded frame).
+    pub(super) fn write_wire(&mut self, len: usize) -> Result<(), StreamError> {
+        self.link.wire_bytes += len as u64;
         self.writer
-            .write_all(&self.wire[..n])
+            .write_all(&self.wire[..len])
             .map_err(|e| StreamError::Disconnected {
                 detail: format!("writing to the port failed: {e}"),
             })
@@ -281,10 +295,11 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             });
         }
         let caps = ack.capabilities;
+        let (mode, no_mode) = self.session.required_mode();
         let missing = if !caps.chips.contains(Chips::MPU9250) {
             Some("it does not emulate the MPU-9250")
-        } else if !caps.modes.contains(Modes::IMAGES) {
-            Some("it does not take register images")
+        } else if !caps.modes.contains(mode) {
+            Some(no_mode)
         } else if caps.max_batch == 0 || caps.buffer_capacity == 0 {
             Some("it announces no batch or buffer space")
         } else {
@@ -304,10 +319,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
 
     fn configure(&mut self) -> Result<(), StreamError> {
         let period = self.session.config.telemetry_period.as_nanos() as u64;
-        let cfg = Configure {
-            telemetry_period_ns: period,
-            ..Configure::new(WHO_AM_I, self.session.rate)
-        };
+        let cfg = self.session.configure_message(period);
         self.credit_seen = false;
         self.send(&Message::Configure(cfg))?;
         let deadline = Instant::now() + self.session.config.hello_timeout;
@@ -320,7 +332,14 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             }
             self.pump(deadline)?;
         }
-        self.event("configured", &format!("credit limit {}", self.credit.limit))
+        self.plan_pacing();
+        let detail = format!(
+            "credit limit {}; batch {}; lead {} us",
+            self.credit.limit,
+            self.batch,
+            self.lead.as_micros()
+        );
+        self.event("configured", &detail)
     }
 
     pub(super) fn report(&mut self, force: bool) {
@@ -336,7 +355,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     fn progress_now(&self) -> Progress {
         Progress {
             sent: self.next,
-            total: self.total(),
+            total: self.session.stream_len(),
             elapsed: self.start.map_or(Duration::ZERO, |s| s.elapsed()),
             telemetry: self.telemetry,
             host_rx: self.host_rx,
@@ -358,6 +377,11 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             host_rx: self.host_rx,
             credit_stalls: self.credit_stalls,
             served: self.served.stats(),
+            stream_len: self.session.stream_len(),
+            source: self.session.source(),
+            batch: self.batch,
+            lead: self.lead,
+            link: self.link,
             image_settings: self.session.settings,
             elapsed: self.start.map_or(Duration::ZERO, |s| s.elapsed()),
         }

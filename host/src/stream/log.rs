@@ -9,7 +9,7 @@
 //! | file | columns |
 //! |---|---|
 //! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample of the scene |
-//! | `sent.csv` | `index,t_ns,send_ns,late_ns,image`: sample index, its latch instant, when its batch was written to the port, how late that write was against its schedule `start_host_ns + t_ns − lead` for the batch's first sample (empty for the prefill, written before Start), and the 22-byte register image as 44 lowercase hex digits |
+//! | `sent.csv` | source images: `index,t_ns,send_ns,late_ns,image`: sample index, its latch instant, when its batch was written to the port, how late that write was against its schedule `start_host_ns + t_ns − lead` for the batch's first sample (empty for the prefill, written before Start), and the 22-byte register image as 44 lowercase hex digits. Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c`: the kinematics sample's index and instant at the kinematics rate, the same times, then the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip |
 //! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
@@ -18,6 +18,7 @@
 
 use crate::output::TruthWriter;
 use crate::truth::Truth;
+use margemu_model::sensor;
 use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -25,8 +26,11 @@ use std::path::{Path, PathBuf};
 
 use super::images::image_hex;
 
-/// Header of `sent.csv`.
+/// Header of `sent.csv` in source mode images.
 pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image";
+/// Header of `sent.csv` in source mode model.
+pub const SENT_KINEMATICS_COLUMNS: &str =
+    "index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c";
 /// Header of `served.csv`.
 pub const SERVED_COLUMNS: &str = "host_ns,index,time_ns,crc32c,underrun,empty,match";
 /// Header of `device.csv`.
@@ -43,6 +47,7 @@ pub const EVENTS_COLUMNS: &str = "host_ns,event,detail";
 /// The open CSV files of one session.
 pub struct SessionLog {
     dir: PathBuf,
+    float: ryu::Buffer,
     sent: BufWriter<File>,
     served: BufWriter<File>,
     device: BufWriter<File>,
@@ -58,13 +63,15 @@ fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
 }
 
 impl SessionLog {
-    /// Creates `dir` and every file but `truth.csv`, with their headers, and writes `meta.toml`.
-    pub fn create(dir: &Path, meta: &str) -> io::Result<Self> {
+    /// Creates `dir` and every file but `truth.csv`, with their headers (`sent_columns`: the
+    /// source mode's), and writes `meta.toml`.
+    pub fn create(dir: &Path, meta: &str, sent_columns: &str) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
         std::fs::write(dir.join("meta.toml"), meta)?;
         let mut log = Self {
             dir: dir.to_path_buf(),
-            sent: create(dir, "sent.csv", SENT_COLUMNS)?,
+            float: ryu::Buffer::new(),
+            sent: create(dir, "sent.csv", sent_columns)?,
             served: create(dir, "served.csv", SERVED_COLUMNS)?,
             device: create(dir, "device.csv", DEVICE_COLUMNS)?,
             telemetry: create(dir, "telemetry.csv", TELEMETRY_COLUMNS)?,
@@ -90,8 +97,8 @@ impl SessionLog {
         out.finish()?.flush()
     }
 
-    /// One row of `sent.csv`.
-    pub fn sent(
+    /// One row of `sent.csv` in source mode images.
+    pub fn sent_image(
         &mut self,
         index: u64,
         t_ns: u64,
@@ -99,12 +106,45 @@ impl SessionLog {
         late_ns: Option<i64>,
         image: &Image,
     ) -> io::Result<()> {
+        self.sent_times(index, t_ns, send_ns, late_ns)?;
+        writeln!(self.sent, ",{}", image_hex(image))
+    }
+
+    /// One row of `sent.csv` in source mode model.
+    pub fn sent_kinematics(
+        &mut self,
+        index: u64,
+        t_ns: u64,
+        send_ns: i64,
+        late_ns: Option<i64>,
+        k: &sensor::Truth,
+    ) -> io::Result<()> {
+        self.sent_times(index, t_ns, send_ns, late_ns)?;
+        let values = k
+            .angular_rate
+            .iter()
+            .chain(&k.specific_force)
+            .chain(&k.magnetic_field)
+            .chain(&k.angular_acceleration)
+            .chain(&k.temperature_c);
+        for v in values {
+            write!(self.sent, ",{}", self.float.format(*v))?;
+        }
+        if k.temperature_c.is_none() {
+            self.sent.write_all(b",")?;
+        }
+        self.sent.write_all(b"\n")
+    }
+
+    fn sent_times(
+        &mut self,
+        index: u64,
+        t_ns: u64,
+        send_ns: i64,
+        late_ns: Option<i64>,
+    ) -> io::Result<()> {
         let late = late_ns.map_or(String::new(), |v| v.to_string());
-        writeln!(
-            self.sent,
-            "{index},{t_ns},{send_ns},{late},{}",
-            image_hex(image)
-        )
+        write!(self.sent, "{index},{t_ns},{send_ns},{late}")
     }
 
     /// One row of `served.csv`; `matches` is `None` after the scene's last sample.

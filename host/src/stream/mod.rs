@@ -31,14 +31,17 @@ mod flow;
 pub mod images;
 pub mod log;
 mod meta;
+pub mod model;
 mod pacing;
 pub mod rx;
 pub mod served;
 mod session;
+mod source;
 
 pub use images::{image_hex, parse_image_hex, predict, ImageSettings, PredictedSample};
+pub use model::{kinematics_hold, model_images, predict_model, ModelPrediction};
 pub use served::{ServedCheck, ServedStats};
-pub use session::{rate_of, Session, StreamConfig, WHO_AM_I};
+pub use session::{rate_of, Session, SourceMode, StreamConfig, WHO_AM_I};
 
 use margemu_protocol::link::{HelloAck, RxStats, Telemetry};
 use std::path::PathBuf;
@@ -107,6 +110,20 @@ pub enum StreamError {
         /// What the port said.
         detail: String,
     },
+    /// source mode model cannot run this scene: {reason}
+    Model {
+        /// Why.
+        reason: String,
+    },
+    /// the kinematics rate {hz} Hz does not divide the output rate {out_hz} Hz: the device holds each kinematics sample for a whole number of output samples (e.g. {hint})
+    KinematicsRate {
+        /// The rate asked for.
+        hz: f64,
+        /// The scene's output rate.
+        out_hz: f64,
+        /// Rates that would do.
+        hint: String,
+    },
     /// interrupted; the device was asked to stop and the logs are complete up to here
     Interrupted,
 }
@@ -114,9 +131,9 @@ pub enum StreamError {
 /// What a running session reports to its progress callback.
 #[derive(Clone, Copy, Debug)]
 pub struct Progress {
-    /// Samples written to the port.
+    /// Items written to the port (images, or kinematics samples in source mode model).
     pub sent: u64,
-    /// Samples in the scene.
+    /// Items in the stream.
     pub total: u64,
     /// Time since Start.
     pub elapsed: Duration,
@@ -167,13 +184,44 @@ impl JitterStats {
     }
 }
 
+/// What the host wrote to the port.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LinkStats {
+    /// Every byte written (all frames, delimiters included).
+    pub wire_bytes: u64,
+    /// Sample batch frames written.
+    pub batch_frames: u64,
+    /// Their bytes on the wire.
+    pub batch_wire_bytes: u64,
+    /// The item bytes they carried (22 per image, 53 per kinematics sample).
+    pub item_bytes: u64,
+}
+
+impl LinkStats {
+    /// Item bytes per wire byte of the sample batches (link efficiency, before UART framing).
+    pub fn efficiency(&self) -> f64 {
+        self.item_bytes as f64 / self.batch_wire_bytes.max(1) as f64
+    }
+}
+
 /// How a completed session went.
 #[derive(Clone, Debug)]
 pub struct Summary {
     /// Samples in the scene.
     pub samples: u64,
-    /// Samples written to the port.
+    /// Items written to the port (images, or kinematics samples in source mode model), the
+    /// first copy of each.
     pub sent: u64,
+    /// Items in the stream.
+    pub stream_len: u64,
+    /// The source mode (kinematics rate resolved).
+    pub source: SourceMode,
+    /// Items per batch.
+    pub batch: u64,
+    /// How far ahead of their instants batches were written.
+    pub lead: Duration,
+    /// Bytes written.
+    pub link: LinkStats,
     /// The session directory.
     pub dir: PathBuf,
     /// When Start was written, ns since the port was opened (scene time 0).

@@ -1,39 +1,57 @@
 //! Pacing: the prefill, the batches written in real time on the host's monotonic clock within
 //! the device's credit window, and the Stop after the last sample's instant.
+//!
+//! Items (images, or kinematics in source mode model) are written in batches of up to
+//! `StreamConfig::batch`, capped by the frame, by the device's `max_batch` and by a quarter of
+//! its buffer. The batch starting at item `j` is due at `start + t_j − lead`, where the lead is
+//! `StreamConfig::lead` capped at 3/8 of the device's buffer (so a due batch normally finds the
+//! credit it needs: the device grants its window a quarter of its buffer at a time). The last
+//! 200 µs before a due instant are busy-waited.
 
 use super::flow::Run;
 use super::Progress;
 use super::StreamError;
-use margemu_protocol::link::{
-    DeviceState, Image, ImageBatch, Message, Start, MAX_IMAGES_PER_BATCH,
-};
+use margemu_protocol::link::{DeviceState, Message, Start};
 use std::io::Write;
 use std::time::{Duration, Instant};
 
 impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
-    fn batch_len(&self) -> u64 {
-        let device = self
-            .ack
-            .map_or(1, |a| usize::from(a.capabilities.max_batch));
-        self.session
+    /// Sets the batch size and the lead from the device's HelloAck (see the module docs).
+    pub(super) fn plan_pacing(&mut self) {
+        let (max_batch, capacity) = self.ack.map_or((1, 4), |a| {
+            let c = a.capabilities;
+            (usize::from(c.max_batch), c.buffer_capacity as usize)
+        });
+        let batch = self
+            .session
             .config
             .batch
-            .min(device)
-            .clamp(1, MAX_IMAGES_PER_BATCH) as u64
+            .min(max_batch)
+            .min(self.session.max_per_frame())
+            .min(capacity / 4)
+            .max(1);
+        let window = self
+            .session
+            .item_rate()
+            .sample_time_ns(3 * capacity as u64 / 8);
+        self.batch = batch as u64;
+        self.lead = self.session.config.lead.min(Duration::from_nanos(window));
     }
 
-    /// The instant the batch starting at sample `k` is due (`None` before Start).
-    fn due(&self, k: u64) -> Option<Instant> {
-        let t = Duration::from_nanos(self.session.rate.sample_time_ns(k));
+    /// The instant the batch starting at item `j` is due (`None` before Start).
+    fn due(&self, j: u64) -> Option<Instant> {
+        let t = Duration::from_nanos(self.session.item_rate().sample_time_ns(j));
         let start = self.start?;
         Some(
             (start + t)
-                .checked_sub(self.session.config.lead)
+                .checked_sub(self.lead)
                 .unwrap_or(start)
                 .max(start),
         )
     }
 
+    /// Writes items `next .. next + n`; `late_ns` is how late against schedule (`None`: not
+    /// paced), and a `paced` batch counts in the jitter figures.
     fn write_batch(
         &mut self,
         n: u64,
@@ -41,37 +59,34 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         paced: bool,
     ) -> Result<(), StreamError> {
         let first = self.next;
-        let range = first as usize..(first + n) as usize;
-        let images: Vec<Image> = self.session.samples[range.clone()]
-            .iter()
-            .map(|s| s.image)
-            .collect();
-        self.send(&Message::Images(ImageBatch::new(first, &images)))?;
+        let len = self
+            .session
+            .emit_batch(first, n, &mut self.encoder, &mut self.wire);
+        self.write_wire(len)?;
+        self.link.batch_frames += 1;
+        self.link.batch_wire_bytes += len as u64;
+        self.link.item_bytes += n * self.session.item_len();
         let send_ns = self.host_ns(Instant::now());
         if let (Some(l), true) = (late_ns, paced) {
             self.late.push(l);
             self.max_late_ns = self.max_late_ns.max(l);
         }
-        for (i, s) in self.session.samples[range].iter().enumerate() {
-            let k = first + i as u64;
-            let r = self
-                .session
-                .log
-                .sent(k, s.truth.t_ns, send_ns, late_ns, &s.image);
-            r.map_err(self.log_err())?;
-        }
         self.next += n;
-        let r = self.session.log.flush();
-        r.map_err(self.log_err())
+        let logged = self
+            .session
+            .log_sent(first, n, send_ns, late_ns)
+            .and_then(|()| self.session.log.flush());
+        logged.map_err(self.log_err())
     }
 
     pub(super) fn stream(&mut self) -> Result<(), StreamError> {
-        let total = self.total();
-        let batch = self.batch_len();
-        let lead_ns = self.session.config.lead.as_nanos() as u64;
-        // Prefill: every sample due at Start, within the first window.
+        let total = self.session.stream_len();
+        let batch = self.batch;
+        let lead_ns = self.lead.as_nanos() as u64;
+        let rate = self.session.item_rate();
+        // Prefill: every item due at Start, within the first window.
         while self.next < total
-            && self.session.rate.sample_time_ns(self.next) <= lead_ns
+            && rate.sample_time_ns(self.next) <= lead_ns
             && self.credit.available(self.next) > 0
         {
             let n = batch
@@ -128,8 +143,8 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         Ok(())
     }
 
-    /// Sends Stop half a period after the last sample's instant (so the device serves it and
-    /// no instant after it), then waits for Telemetry in the stopped state.
+    /// Sends Stop half an output period after the last sample's instant (so the device serves
+    /// it and no instant after it), then waits for Telemetry in the stopped state.
     pub(super) fn finish(&mut self) -> Result<(), StreamError> {
         let total = self.total();
         let drain = self.session.config.drain_timeout;

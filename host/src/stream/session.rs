@@ -3,9 +3,11 @@
 
 use super::flow::Run;
 use super::images::{predict, ImageSettings, PredictedSample};
-use super::log::SessionLog;
+use super::log::{SessionLog, SENT_COLUMNS, SENT_KINEMATICS_COLUMNS};
 use super::meta::metadata;
+use super::model::predict_model;
 use super::rx;
+use super::source::Items;
 use super::{Progress, StreamError, Summary};
 use crate::scene::Scene;
 use margemu_protocol::link::Rate;
@@ -18,6 +20,21 @@ use std::time::{Duration, Instant};
 /// WHO_AM_I of the emulated chip: the MPU-9250.
 pub const WHO_AM_I: u8 = 0x71;
 
+/// Where the device's samples come from (`docs/spec/link.md` §5.3).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum SourceMode {
+    /// (a) The host sends every register image.
+    #[default]
+    Images,
+    /// (b) The host sends true kinematics and the device runs the shared sensor model
+    /// ([`predict_model`](super::predict_model)).
+    Model {
+        /// Kinematics rate, Hz: the output rate over a whole number; `None`: the default of
+        /// [`kinematics_hold`](super::kinematics_hold).
+        kinematics_hz: Option<f64>,
+    },
+}
+
 /// Settings of a streaming session. `Default` suits a board or a PTY at 1–8 kHz.
 #[derive(Clone, Debug)]
 pub struct StreamConfig {
@@ -27,9 +44,12 @@ pub struct StreamConfig {
     pub baud: u32,
     /// Physical → register conversion; `None`: [`ImageSettings::for_scene`].
     pub images: Option<ImageSettings>,
-    /// How far ahead of its first sample's instant a batch is written.
+    /// Register images or the device's own model.
+    pub source: SourceMode,
+    /// How far ahead of its first sample's instant a batch is written (capped at 3/8 of the
+    /// device's buffer).
     pub lead: Duration,
-    /// Most images per batch (also capped by the device's `max_batch` and the frame size).
+    /// Most samples per batch (also capped by the device's `max_batch` and the frame size).
     pub batch: usize,
     /// Telemetry period asked of the device.
     pub telemetry_period: Duration,
@@ -52,7 +72,8 @@ impl Default for StreamConfig {
             port: String::new(),
             baud: 921_600,
             images: None,
-            lead: Duration::from_millis(20),
+            source: SourceMode::Images,
+            lead: Duration::from_millis(50),
             batch: 32,
             telemetry_period: Duration::from_millis(50),
             hello_timeout: Duration::from_secs(2),
@@ -70,25 +91,41 @@ pub struct Session {
     pub(super) settings: ImageSettings,
     pub(super) rate: Rate,
     pub(super) samples: Vec<PredictedSample>,
+    pub(super) items: Items,
     pub(super) log: SessionLog,
     pub(super) stop: Arc<AtomicBool>,
 }
 
 impl Session {
-    /// Predicts every image of `scene` and creates the session directory `dir` (`meta.toml`,
-    /// `truth.csv`, the other files with their headers).
+    /// Predicts every image of `scene` (in source mode model, after checking the device can run
+    /// it) and creates the session directory `dir` (`meta.toml`, `truth.csv`, the other files
+    /// with their headers). Nothing is sent yet.
     pub fn new(scene: &Scene, config: StreamConfig, dir: &Path) -> Result<Self, StreamError> {
         let settings = config
             .images
             .unwrap_or_else(|| ImageSettings::for_scene(scene));
         let rate = rate_of(scene)?;
-        let samples = predict(scene, &settings)?;
-        let meta = metadata(scene, &config, &settings, rate);
+        let (samples, items, hold) = match config.source {
+            SourceMode::Images => (predict(scene, &settings)?, Items::Images, None),
+            SourceMode::Model { kinematics_hz } => {
+                let p = predict_model(scene, &settings, kinematics_hz)?;
+                let items = Items::Kinematics {
+                    params: Box::new(p.params),
+                    samples: p.kinematics,
+                };
+                (p.samples, items, Some(p.hold))
+            }
+        };
+        let meta = metadata(scene, &config, &settings, rate, hold);
         let log_err = |source| StreamError::Log {
             path: dir.to_path_buf(),
             source,
         };
-        let log = SessionLog::create(dir, &meta).map_err(log_err)?;
+        let sent_columns = match items {
+            Items::Images => SENT_COLUMNS,
+            Items::Kinematics { .. } => SENT_KINEMATICS_COLUMNS,
+        };
+        let log = SessionLog::create(dir, &meta, sent_columns).map_err(log_err)?;
         log.write_truth(samples.iter().map(|s| &s.truth))
             .map_err(log_err)?;
         Ok(Self {
@@ -96,6 +133,7 @@ impl Session {
             settings,
             rate,
             samples,
+            items,
             log,
             stop: Arc::new(AtomicBool::new(false)),
         })
@@ -107,7 +145,7 @@ impl Session {
         self.stop.clone()
     }
 
-    /// The predicted samples, in order (truth and image).
+    /// The predicted output samples, in order (truth and the image the device should serve).
     pub fn samples(&self) -> &[PredictedSample] {
         &self.samples
     }
