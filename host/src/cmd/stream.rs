@@ -88,13 +88,15 @@ impl Cmd {
             self.lead_ms.is_finite() && self.lead_ms >= 0.0,
             "--lead-ms must be ≥ 0"
         );
+        let batch = self.batch.max(1);
         let config = StreamConfig {
             port: self.port.clone(),
             baud: self.baud,
             images: Some(images),
             source: self.source.mode()?,
             lead: Duration::from_secs_f64(self.lead_ms / 1000.0),
-            batch: self.batch.max(1),
+            batch,
+            resend_after: resend_after(batch, self.baud),
             ..StreamConfig::default()
         };
         let port =
@@ -108,6 +110,21 @@ impl Cmd {
         )?;
         Ok(())
     }
+}
+
+/// A batch counts as lost 3 ms plus two line times of the largest batch after its write (the
+/// batch before it may still be on the line).
+fn resend_after(batch: usize, baud: u32) -> Duration {
+    use margemu::stream::batch_wire_len;
+    use margemu_protocol::link::{
+        IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
+    };
+    let bytes = batch_wire_len(batch.min(MAX_IMAGES_PER_BATCH), IMAGE_LEN).max(batch_wire_len(
+        batch.min(MAX_KINEMATICS_PER_BATCH),
+        TRUTH_LEN,
+    ));
+    let line = Duration::from_secs_f64(10.0 * bytes as f64 / f64::from(baud.max(1)));
+    Duration::from_millis(3) + 2 * line
 }
 
 /// Prepares the session of `scene` in `dir` (every image predicted).

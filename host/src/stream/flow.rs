@@ -3,12 +3,13 @@
 //! [`super::pacing`].
 
 use super::meta::device_meta;
+use super::resend::GoBackN;
 use super::rx::{self, DeviceMessage, RxEvent};
 use super::served::ServedCheck;
 use super::session::Session;
 use super::{JitterStats, LinkStats, Progress, StreamError, Summary};
 use margemu_protocol::link::{
-    Chips, Credit, Encoder, ErrorCode, ErrorReport, Hello, HelloAck, Message, RxStats,
+    Chips, Credit, DeviceState, Encoder, ErrorCode, ErrorReport, Hello, HelloAck, Message, RxStats,
     ServedSample, Telemetry, CRC32C,
 };
 use margemu_protocol::PROTOCOL_VERSION;
@@ -46,6 +47,10 @@ pub(super) struct Run<'s, W: Write, P: FnMut(&Progress)> {
     pub(super) lead: Duration,
     /// Bytes written to the port: all, and those of sample batches with their item bytes.
     pub(super) link: LinkStats,
+    /// When each item was last written; the go-backs.
+    pub(super) go_back: GoBackN,
+    /// Stop was written: reports no longer lead to resends.
+    pub(super) stop_sent: bool,
     pub(super) progress: P,
     pub(super) last_progress: Instant,
 }
@@ -60,6 +65,7 @@ impl<'s, W: Write, P: FnMut(&Progress)> Run<'s, W, P> {
     ) -> Self {
         let origin = Instant::now();
         let total = session.samples.len();
+        let go_back = GoBackN::new(session.stream_len());
         let crcs = session.samples.iter().map(|s| CRC32C.checksum(&s.image));
         let served = ServedCheck::new(crcs.collect());
         Self {
@@ -83,6 +89,8 @@ impl<'s, W: Write, P: FnMut(&Progress)> Run<'s, W, P> {
             batch: 1,
             lead: Duration::ZERO,
             link: LinkStats::default(),
+            go_back,
+            stop_sent: false,
             progress,
             last_progress: origin,
         }
@@ -218,10 +226,17 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             .and_then(|()| self.session.log.flush())
             .map_err(self.log_err())?;
         match message {
-            DeviceMessage::Credit(c) => self.window(c),
+            DeviceMessage::Credit(c) => {
+                self.window(c);
+                let capacity = self.ack.map_or(0, |a| a.capabilities.buffer_capacity);
+                let tau = self.session.credit_time_ns(c.limit, u64::from(capacity));
+                self.check_lost(c.next_index, tau)?;
+            }
             DeviceMessage::Telemetry(t) => {
                 self.window(t.credit());
                 self.telemetry = Some(t);
+                let running = t.state == DeviceState::Running;
+                self.check_lost(t.next_index, running.then_some(t.time_ns))?;
             }
             DeviceMessage::HelloAck(a) if a.session == self.session.config.session_id => {
                 self.ack = Some(a);
@@ -265,6 +280,28 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
                 .served(host_ns, k, time_ns, entry, matches)?;
         }
         Ok(())
+    }
+
+    /// Goes back to `next_index` if the device, in a report generated at its scene time
+    /// `tau_ns` or later, still misses an item written long enough before (see [`super::resend`]).
+    fn check_lost(&mut self, next_index: u64, tau_ns: Option<u64>) -> Result<(), StreamError> {
+        let (Some(start), Some(tau), false) = (self.start, tau_ns, self.stop_sent) else {
+            return Ok(());
+        };
+        let margin = self.session.config.resend_after.as_nanos() as i64;
+        let seen_by = self.host_ns(start) + tau as i64 - margin;
+        match self.go_back.lost(next_index, seen_by) {
+            Some(hole) if hole < self.next => {
+                let detail = format!(
+                    "device next_index {hole} at its scene time {tau} ns; going back from {}",
+                    self.next
+                );
+                self.next = hole;
+                self.go_back.rewound();
+                self.event("resend", &detail)
+            }
+            _ => Ok(()),
+        }
     }
 
     fn window(&mut self, c: Credit) {
@@ -354,8 +391,9 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
 
     fn progress_now(&self) -> Progress {
         Progress {
-            sent: self.next,
+            sent: self.go_back.high(),
             total: self.session.stream_len(),
+            resends: self.go_back.rewinds(),
             elapsed: self.start.map_or(Duration::ZERO, |s| s.elapsed()),
             telemetry: self.telemetry,
             host_rx: self.host_rx,
@@ -368,7 +406,9 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     pub(super) fn summary(&self) -> Summary {
         Summary {
             samples: self.total(),
-            sent: self.next,
+            sent: self.go_back.high(),
+            resends: self.go_back.rewinds(),
+            resent: self.go_back.resent(),
             dir: self.session.log.dir().to_path_buf(),
             start_host_ns: self.start.map(|s| self.host_ns(s)),
             jitter: JitterStats::from_lateness(&self.late),

@@ -9,12 +9,12 @@
 //! | file | columns |
 //! |---|---|
 //! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample of the scene |
-//! | `sent.csv` | source images: `index,t_ns,send_ns,late_ns,image`: sample index, its latch instant, when its batch was written to the port, how late that write was against its schedule `start_host_ns + t_ns − lead` for the batch's first sample (empty for the prefill, written before Start), and the 22-byte register image as 44 lowercase hex digits. Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c`: the kinematics sample's index and instant at the kinematics rate, the same times, then the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip |
+//! | `sent.csv` | one row per item written, in the order written. Source images: `index,t_ns,send_ns,late_ns,image,resend`: sample index, its latch instant, when its batch was written to the port, how late that write was against its schedule `start_host_ns + t_ns − lead` for the batch's first sample (empty for the prefill, written before Start, and for resends), the 22-byte register image as 44 lowercase hex digits, and `1` if the item was written again because the device had not received it (go-back-N; `0` for the first copy). Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend`: the kinematics sample's index and instant at the kinematics rate, the same times, the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip, and the resend flag |
 //! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before`: each write of the device under test (`bus` spi, i2c or aux; `dropped_before`: writes the device lost just before this batch) |
-//! | `events.csv` | `host_ns,event,detail`: handshake, credit stalls, device errors and resets, host receive errors, and how the session ended |
+//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`) |
 
 use crate::output::TruthWriter;
 use crate::truth::Truth;
@@ -27,10 +27,10 @@ use std::path::{Path, PathBuf};
 use super::images::image_hex;
 
 /// Header of `sent.csv` in source mode images.
-pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image";
+pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image,resend";
 /// Header of `sent.csv` in source mode model.
 pub const SENT_KINEMATICS_COLUMNS: &str =
-    "index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c";
+    "index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend";
 /// Header of `served.csv`.
 pub const SERVED_COLUMNS: &str = "host_ns,index,time_ns,crc32c,underrun,empty,match";
 /// Header of `device.csv`.
@@ -105,9 +105,10 @@ impl SessionLog {
         send_ns: i64,
         late_ns: Option<i64>,
         image: &Image,
+        resend: bool,
     ) -> io::Result<()> {
         self.sent_times(index, t_ns, send_ns, late_ns)?;
-        writeln!(self.sent, ",{}", image_hex(image))
+        writeln!(self.sent, ",{},{}", image_hex(image), u8::from(resend))
     }
 
     /// One row of `sent.csv` in source mode model.
@@ -118,6 +119,7 @@ impl SessionLog {
         send_ns: i64,
         late_ns: Option<i64>,
         k: &sensor::Truth,
+        resend: bool,
     ) -> io::Result<()> {
         self.sent_times(index, t_ns, send_ns, late_ns)?;
         let values = k
@@ -133,7 +135,7 @@ impl SessionLog {
         if k.temperature_c.is_none() {
             self.sent.write_all(b",")?;
         }
-        self.sent.write_all(b"\n")
+        writeln!(self.sent, ",{}", u8::from(resend))
     }
 
     fn sent_times(

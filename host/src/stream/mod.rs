@@ -33,6 +33,7 @@ pub mod log;
 mod meta;
 pub mod model;
 mod pacing;
+pub mod resend;
 pub mod rx;
 pub mod served;
 mod session;
@@ -135,6 +136,8 @@ pub struct Progress {
     pub sent: u64,
     /// Items in the stream.
     pub total: u64,
+    /// Go-backs so far (items the device had not received, written again).
+    pub resends: u64,
     /// Time since Start.
     pub elapsed: Duration,
     /// The device's latest Telemetry (served samples, underruns, its receive errors).
@@ -212,6 +215,11 @@ pub struct Summary {
     /// Items written to the port (images, or kinematics samples in source mode model), the
     /// first copy of each.
     pub sent: u64,
+    /// Go-backs: times the device reported an item missing that was written long enough
+    /// before, and the session wrote it and the items after it again.
+    pub resends: u64,
+    /// Items written more than once.
+    pub resent: u64,
     /// Items in the stream.
     pub stream_len: u64,
     /// The source mode (kinematics rate resolved).
@@ -244,6 +252,14 @@ pub struct Summary {
     pub elapsed: Duration,
 }
 
+/// Worst-case wire bytes of a batch frame of `n` items of `item_len` bytes each (22 for an
+/// image, 53 for a kinematics sample): header, first index, items, CRC, worst-case COBS and
+/// both delimiters.
+pub fn batch_wire_len(n: usize, item_len: usize) -> usize {
+    use margemu_protocol::link::{max_wire_len, CRC_LEN, HEADER_LEN};
+    max_wire_len(HEADER_LEN + 8 + n * item_len + CRC_LEN)
+}
+
 /// Opens a serial port for a session (no exclusive lock, 50 ms read timeout).
 pub fn open_port(path: &str, baud: u32) -> Result<serialport::TTYPort, StreamError> {
     let port = serialport::new(path, baud)
@@ -256,6 +272,14 @@ pub fn open_port(path: &str, baud: u32) -> Result<serialport::TTYPort, StreamErr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn batch_sizes_agree_with_the_protocol() {
+        use margemu_protocol::link::{image_batch_wire_len, IMAGE_LEN, TRUTH_LEN};
+        assert_eq!(batch_wire_len(32, IMAGE_LEN), image_batch_wire_len(32));
+        assert_eq!(batch_wire_len(32, IMAGE_LEN), 727);
+        assert_eq!(batch_wire_len(28, TRUTH_LEN), 1510); // docs/spec/link.md §9
+    }
 
     #[test]
     fn jitter_percentiles_by_nearest_rank() {

@@ -51,7 +51,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     }
 
     /// Writes items `next .. next + n`; `late_ns` is how late against schedule (`None`: not
-    /// paced), and a `paced` batch counts in the jitter figures.
+    /// paced, or a resend), and a `paced` batch counts in the jitter figures.
     fn write_batch(
         &mut self,
         n: u64,
@@ -59,6 +59,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         paced: bool,
     ) -> Result<(), StreamError> {
         let first = self.next;
+        let resend = first < self.go_back.high();
         let len = self
             .session
             .emit_batch(first, n, &mut self.encoder, &mut self.wire);
@@ -67,21 +68,23 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         self.link.batch_wire_bytes += len as u64;
         self.link.item_bytes += n * self.session.item_len();
         let send_ns = self.host_ns(Instant::now());
-        if let (Some(l), true) = (late_ns, paced) {
+        self.go_back.written(first, n, send_ns);
+        if let (Some(l), true) = (late_ns, paced && !resend) {
             self.late.push(l);
             self.max_late_ns = self.max_late_ns.max(l);
         }
         self.next += n;
+        let late_ns = late_ns.filter(|_| !resend);
         let logged = self
             .session
-            .log_sent(first, n, send_ns, late_ns)
+            .log_sent(first, n, send_ns, late_ns, resend)
             .and_then(|()| self.session.log.flush());
         logged.map_err(self.log_err())
     }
 
+    /// Prefill, Start, then every item at its due instant (and every go-back at once).
     pub(super) fn stream(&mut self) -> Result<(), StreamError> {
         let total = self.session.stream_len();
-        let batch = self.batch;
         let lead_ns = self.lead.as_nanos() as u64;
         let rate = self.session.item_rate();
         // Prefill: every item due at Start, within the first window.
@@ -89,7 +92,8 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             && rate.sample_time_ns(self.next) <= lead_ns
             && self.credit.available(self.next) > 0
         {
-            let n = batch
+            let n = self
+                .batch
                 .min(self.credit.available(self.next))
                 .min(total - self.next);
             self.write_batch(n, None, false)?;
@@ -102,45 +106,53 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             "start",
             &format!("start_host_ns {start_ns}; prefill {}", self.next),
         )?;
-        let mut stall: Option<Instant> = None;
+        let mut stall = None;
         while self.next < total {
-            self.report(false);
-            let due = self.due(self.next).expect("started");
-            let now = Instant::now();
-            if now + self.session.config.spin < due {
-                self.pump(due - self.session.config.spin)?;
-                continue;
-            }
-            while Instant::now() < due {
-                std::hint::spin_loop();
-            }
-            while let Ok(event) = self.events.try_recv() {
-                self.handle(event)?;
-            }
-            let available = self.credit.available(self.next);
-            if available == 0 {
-                let since = *stall.get_or_insert_with(|| {
-                    self.credit_stalls += 1;
-                    Instant::now()
-                });
-                let limit = since + self.session.config.credit_timeout;
-                if Instant::now() >= limit {
-                    return Err(StreamError::CreditTimeout {
-                        index: self.next,
-                        timeout: self.session.config.credit_timeout,
-                    });
-                }
-                self.pump(limit)?;
-                continue;
-            }
-            // A batch held back by the credit window is late because of the device, not of
-            // the pacing: logged, but left out of the jitter figures.
-            let paced = stall.take().is_none();
-            let n = batch.min(available).min(total - self.next);
-            let late = Instant::now().saturating_duration_since(due).as_nanos() as i64;
-            self.write_batch(n, Some(late), paced)?;
+            self.send_next(&mut stall)?;
         }
         Ok(())
+    }
+
+    /// Waits for the next item's instant (handling device messages meanwhile) and writes its
+    /// batch, within the credit window; a go-back is written at once, up to where it left off.
+    fn send_next(&mut self, stall: &mut Option<Instant>) -> Result<(), StreamError> {
+        let total = self.session.stream_len();
+        self.report(false);
+        let due = self.due(self.next).expect("started");
+        let spin = self.session.config.spin;
+        if Instant::now() + spin < due {
+            return self.pump(due - spin);
+        }
+        while Instant::now() < due {
+            std::hint::spin_loop();
+        }
+        while let Ok(event) = self.events.try_recv() {
+            self.handle(event)?;
+        }
+        let available = self.credit.available(self.next);
+        if available == 0 {
+            let since = *stall.get_or_insert_with(|| {
+                self.credit_stalls += 1;
+                Instant::now()
+            });
+            let limit = since + self.session.config.credit_timeout;
+            if Instant::now() >= limit {
+                return Err(StreamError::CreditTimeout {
+                    index: self.next,
+                    timeout: self.session.config.credit_timeout,
+                });
+            }
+            return self.pump(limit);
+        }
+        // A batch held back by the credit window is late because of the device, not of the
+        // pacing: logged, but left out of the jitter figures.
+        let paced = stall.take().is_none();
+        let mut n = self.batch.min(available).min(total - self.next);
+        if self.next < self.go_back.high() {
+            n = n.min(self.go_back.high() - self.next);
+        }
+        let late = Instant::now().saturating_duration_since(due).as_nanos() as i64;
+        self.write_batch(n, Some(late), paced)
     }
 
     /// Sends Stop half an output period after the last sample's instant (so the device serves
@@ -152,7 +164,12 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             let rate = self.session.rate;
             let (t_last, t_next) = (rate.sample_time_ns(last), rate.sample_time_ns(total));
             let stop_at = start + Duration::from_nanos(t_last + (t_next - t_last) / 2);
+            let mut stall = None;
             while Instant::now() + self.session.config.spin < stop_at {
+                if self.next < self.session.stream_len() {
+                    self.send_next(&mut stall)?; // a go-back
+                    continue;
+                }
                 self.report(false);
                 self.pump(stop_at - self.session.config.spin)?;
             }
@@ -160,6 +177,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
                 std::hint::spin_loop();
             }
         }
+        self.stop_sent = true;
         self.send(&Message::Stop)?;
         let deadline = Instant::now() + drain;
         while Instant::now() < deadline

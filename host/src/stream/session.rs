@@ -64,6 +64,10 @@ pub struct StreamConfig {
     pub spin: Duration,
     /// The session number sent in Hello.
     pub session_id: u32,
+    /// How long after its write an item missing from a device report counts as lost and is
+    /// sent again (go-back-N): the transfer's latency. Over a UART, add the line time of a
+    /// batch (`margemu stream` does).
+    pub resend_after: Duration,
 }
 
 impl Default for StreamConfig {
@@ -75,12 +79,13 @@ impl Default for StreamConfig {
             source: SourceMode::Images,
             lead: Duration::from_millis(50),
             batch: 32,
-            telemetry_period: Duration::from_millis(50),
+            telemetry_period: Duration::from_millis(20),
             hello_timeout: Duration::from_secs(2),
             credit_timeout: Duration::from_secs(2),
             drain_timeout: Duration::from_secs(1),
             spin: Duration::from_micros(200),
             session_id: 0x6D61_7267, // "marg"
+            resend_after: Duration::from_millis(3),
         }
     }
 }
