@@ -1,37 +1,43 @@
 //! The embedded default: the firmware library's link handler ([`Device`]) running on the host,
 //! behind a real pseudo-terminal pair, so a scene streams exactly as to a board.
 //!
-//! The device buffers [`BUFFER`] samples: more than the QEMU board's 128, as a board with a few
-//! tens of KB of RAM to spare would, so that the host's scheduling hiccups on a busy machine
-//! (several ms) stay well inside the lead at 8 kHz and beyond.
+//! The device buffers [`BUFFER`] samples (256 KB, as a board with a large RAM would; the QEMU
+//! board holds 128), so that the lead can absorb what a busy shared machine does to the host's
+//! threads: stalls of tens of ms were measured here.
 //!
 //! [`spawn_device`] starts the device on one end of a `TTYPort::pair()` in a thread. Each turn
-//! of its loop waits up to 1 ms for bytes, serves the sample instants that are due
-//! ([`Device::poll`], as a board's timer interrupt would, before acting on the bytes), feeds
-//! every byte that has arrived ([`Device::feed`], as a UART interrupt would) and polls again,
-//! writing every frame the device sends, on a monotonic clock. The host side is an ordinary [`Session`](crate::stream::Session) on the
-//! other end; it checks the device's own Served reports against its prediction.
+//! of its loop waits up to 1 ms for bytes, feeds every byte that has arrived
+//! ([`Device::feed`], as a UART interrupt would have), then serves the sample instants that are
+//! due and sends what the device has to say ([`Device::poll`]), on a monotonic clock. The host
+//! side is an ordinary [`Session`](crate::stream::Session) on the other end; it checks the
+//! device's own Served reports against its prediction.
 
+use crate::scene::Scene;
+use crate::stream::{Session, StreamConfig, StreamError, Summary};
 use margemu_firmware::link::{Counters, Device};
+use margemu_protocol::link::DeviceState;
 use serialport::{SerialPort, TTYPort};
 use std::io::{Read, Write};
 use std::ops::ControlFlow;
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// Samples the loopback device buffers (its credit window).
-pub const BUFFER: usize = 1024;
+pub const BUFFER: usize = 4096;
 
 /// The loopback device: the firmware's link handler with a [`BUFFER`]-sample window.
 pub type Firmware = Device<BUFFER>;
 
 /// What the loopback device counted, and why it ended.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct DeviceReport {
     /// The device's counters at the end (served, underruns, overruns, receive errors).
     pub counters: Counters,
+    /// Its session state at the end.
+    pub state: DeviceState,
     /// Why the device loop ended (stop flag, end of file, or a port error).
     pub ended: String,
 }
@@ -47,10 +53,27 @@ impl LoopbackDevice {
     pub fn stop(self) -> DeviceReport {
         self.stop.store(true, Ordering::Relaxed);
         self.thread.join().unwrap_or_else(|_| DeviceReport {
+            counters: Counters::default(),
+            state: DeviceState::Idle,
             ended: "the device thread panicked".into(),
-            ..DeviceReport::default()
         })
     }
+}
+
+/// Streams `scene` with `config` to a loopback device on a fresh PTY pair (the session's logs
+/// in `dir`): the session's outcome and the device's report. Fails before streaming if the
+/// session cannot be prepared or the PTY pair opened.
+pub fn run(
+    scene: &Scene,
+    config: StreamConfig,
+    dir: &Path,
+) -> Result<(Result<Summary, StreamError>, DeviceReport), StreamError> {
+    let port_err = |e: serialport::Error| StreamError::Port { source: e.into() };
+    let (host, device) = TTYPort::pair().map_err(port_err)?;
+    let session = Session::new(scene, config, dir)?;
+    let device = spawn_device(device).map_err(|source| StreamError::Port { source })?;
+    let result = session.run_on_port(host, |_| {});
+    Ok((result, device.stop()))
 }
 
 /// Runs the firmware's [`Device`] on `port` (one end of a pseudo-terminal pair) until stopped.
@@ -65,7 +88,7 @@ pub fn spawn_device(port: TTYPort) -> std::io::Result<LoopbackDevice> {
 /// closed).
 pub fn spawn_device_with(
     mut port: TTYPort,
-    mut hook: impl FnMut(&mut Box<Firmware>, u64) -> ControlFlow<String> + Send + 'static,
+    mut hook: impl FnMut(&mut Firmware, u64) -> ControlFlow<String> + Send + 'static,
 ) -> std::io::Result<LoopbackDevice> {
     port.set_timeout(Duration::from_millis(1))?;
     let stop = Arc::new(AtomicBool::new(false));
@@ -91,38 +114,39 @@ pub fn spawn_device_with(
             };
             DeviceReport {
                 counters: *device.counters(),
+                state: device.state(),
                 ended,
             }
         })?;
     Ok(LoopbackDevice { stop, thread })
 }
 
-/// One turn of the device loop: wait up to 1 ms for bytes, serve the instants due by then (as a
-/// board's timer interrupt would, before the bytes are acted on), take every byte that has
-/// arrived (as a UART interrupt would; at most 64 reads), and send what the device has to say. `Ok(false)` at end
-/// of file.
+/// One turn of the device loop: wait up to 1 ms for bytes; at that moment `t`, take every byte
+/// the PTY has delivered (as a UART interrupt would have as they came; at most 64 reads), then
+/// serve the instants due by `t` and send what the device has to say as of `t`. So a report
+/// stamped `t` reflects every byte delivered by `t`, and a sample delivered before its instant
+/// is served even if this thread was starved meanwhile (on a loaded machine it can be, for tens
+/// of ms). `Ok(false)` at end of file.
 fn turn(device: &mut Firmware, port: &mut TTYPort, now: impl Fn() -> u64) -> std::io::Result<bool> {
     let mut buf = [0u8; 4096];
-    let mut n = match port.read(&mut buf) {
+    let n = match port.read(&mut buf) {
         Ok(0) => return Ok(false),
         Ok(n) => n,
         Err(e) if crate::stream::rx::is_transient(&e) => 0,
         Err(e) => return Err(e),
     };
-    let mut out = Vec::new();
-    let mut tx = |frame: &[u8]| out.extend_from_slice(frame);
-    device.poll(now(), &mut tx);
+    let t = now();
+    device.feed(&buf[..n], t);
+    // Whatever the PTY delivered by `t` is counted by `bytes_to_read` now.
     for _ in 0..64 {
-        if n == 0 {
+        if port.bytes_to_read()? == 0 {
             break;
         }
+        let n = port.read(&mut buf)?;
         device.feed(&buf[..n], now());
-        n = match port.bytes_to_read()? {
-            0 => 0,
-            _ => port.read(&mut buf)?,
-        };
     }
-    device.poll(now(), &mut tx);
+    let mut out = Vec::new();
+    device.poll(t, &mut |frame: &[u8]| out.extend_from_slice(frame));
     port.write_all(&out)?;
     Ok(true)
 }

@@ -2,6 +2,9 @@
 //! batches the device never received are sent again from its `next_index`, in time to be
 //! served byte for byte, in both source modes.
 
+mod common;
+
+use common::{config, scratch};
 use margemu::scene::Scene;
 use margemu::stream::{Session, SourceMode, StreamConfig, Summary};
 use margemu_protocol::link::{Accumulator, FeedResult, FrameRepr, Message};
@@ -46,6 +49,14 @@ impl<W: Write> Write for LosingBatches<W> {
     }
 }
 
+fn batches_of_16(source: SourceMode) -> StreamConfig {
+    StreamConfig {
+        source,
+        batch: 16,
+        ..config()
+    }
+}
+
 fn scene(rate: f64) -> Scene {
     let text = format!(
         "duration = 1.0\nrate = {rate}\nseed = 21\nmotion = \"kinematic\"\n\
@@ -55,16 +66,10 @@ fn scene(rate: f64) -> Scene {
     Scene::parse_str(&text, std::path::Path::new("resend.toml")).unwrap()
 }
 
-fn run(name: &str, scene: &Scene, source: SourceMode, lose: &[u64]) -> (Summary, Vec<u64>) {
-    let dir = std::env::temp_dir().join(format!("margemu-resend-{}-{name}", std::process::id()));
+fn run(name: &str, scene: &Scene, config: StreamConfig, lose: &[u64]) -> (Summary, Vec<u64>) {
+    let dir = scratch(&format!("resend-{name}"));
     let (host, device) = TTYPort::pair().unwrap();
     let device = margemu::loopback::spawn_device(device).unwrap();
-    let config = StreamConfig {
-        port: "pty".into(),
-        source,
-        batch: 16,
-        ..StreamConfig::default()
-    };
     let session = Session::new(scene, config, &dir).unwrap();
     let reader = host.try_clone_native().unwrap();
     let writer = LosingBatches {
@@ -96,9 +101,9 @@ fn run(name: &str, scene: &Scene, source: SourceMode, lose: &[u64]) -> (Summary,
 #[test]
 fn lost_image_batches_are_resent_and_served_byte_for_byte() {
     let scene = scene(1000.0);
-    // Prefill goes up to 50 ms; these batches are paced, one of them the last.
+    // The prefill goes up to the 200 ms lead: one lost batch of it, two paced ones, the last.
     let lose = [160, 480, 992];
-    let (summary, resends) = run("images", &scene, SourceMode::Images, &lose);
+    let (summary, resends) = run("images", &scene, batches_of_16(SourceMode::Images), &lose);
     assert_eq!(
         resends, lose,
         "one go-back per lost batch, from its first index"
@@ -134,7 +139,7 @@ fn lost_kinematics_batches_are_resent_in_source_mode_model() {
         kinematics_hz: Some(500.0),
     };
     let lose = [96, 304];
-    let (summary, resends) = run("model", &scene, source, &lose);
+    let (summary, resends) = run("model", &scene, batches_of_16(source), &lose);
     assert_eq!(resends, lose);
     let s = summary.served;
     assert_eq!((s.byte_exact, s.lost()), (2000, 0), "{s:?}");
@@ -142,11 +147,15 @@ fn lost_kinematics_batches_are_resent_in_source_mode_model() {
 
 #[test]
 fn a_resend_needs_a_report_generated_after_the_batch_could_arrive() {
-    // Without loss, nothing is resent: reports of batches still in flight are not losses.
+    // Without loss, nothing is resent: reports of batches still in flight are not losses. (A
+    // loaded machine's PTY can take well over 10 ms to deliver: the margin here covers it.)
     let scene = scene(1000.0);
-    let (summary, resends) = run("clean", &scene, SourceMode::Images, &[]);
+    let config = StreamConfig {
+        resend_after: Duration::from_millis(100),
+        ..batches_of_16(SourceMode::Images)
+    };
+    let (summary, resends) = run("clean", &scene, config, &[]);
     assert!(resends.is_empty(), "{resends:?}");
     assert_eq!((summary.resends, summary.resent), (0, 0));
     assert_eq!(summary.served.byte_exact, 1000);
-    let _ = Duration::ZERO;
 }

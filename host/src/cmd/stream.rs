@@ -23,7 +23,7 @@ pub struct Cmd {
     output: Option<PathBuf>,
     /// Write each batch this many milliseconds before its first sample's instant (at most 3/8
     /// of the device's buffer).
-    #[arg(long, default_value_t = 50.0)]
+    #[arg(long, default_value_t = 200.0)]
     lead_ms: f64,
     /// Most register images per batch.
     #[arg(long, default_value_t = 32)]
@@ -112,7 +112,7 @@ impl Cmd {
     }
 }
 
-/// A batch counts as lost 3 ms plus two line times of the largest batch after its write (the
+/// A batch counts as lost 20 ms plus two line times of the largest batch after its write (the
 /// batch before it may still be on the line).
 fn resend_after(batch: usize, baud: u32) -> Duration {
     use margemu::stream::batch_wire_len;
@@ -124,7 +124,7 @@ fn resend_after(batch: usize, baud: u32) -> Duration {
         TRUTH_LEN,
     ));
     let line = Duration::from_secs_f64(10.0 * bytes as f64 / f64::from(baud.max(1)));
-    Duration::from_millis(3) + 2 * line
+    Duration::from_millis(20) + 2 * line
 }
 
 /// Prepares the session of `scene` in `dir` (every image predicted).

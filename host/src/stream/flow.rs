@@ -113,9 +113,13 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         }
     }
 
-    pub(super) fn event(&mut self, event: &str, detail: &str) -> Result<(), StreamError> {
+    pub(super) fn event(&mut self, event: &'static str, detail: &str) -> Result<(), StreamError> {
         let now = self.host_ns(Instant::now());
-        let r = self.session.log.event(now, event, detail);
+        let detail = detail.to_owned();
+        let r = self
+            .session
+            .log
+            .write(move |log| log.event(now, event, &detail));
         r.map_err(self.log_err())
     }
 
@@ -200,21 +204,30 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         message: DeviceMessage,
     ) -> Result<(), StreamError> {
         let host_ns = self.host_ns(at);
+        let rate = self.session.rate;
         let log = &mut self.session.log;
         let written = match &message {
             DeviceMessage::Telemetry(t) => {
-                let t_ns = (t.samples_served > 0)
-                    .then(|| self.session.rate.sample_time_ns(t.last_served_index));
-                log.telemetry(host_ns, seq, t, t_ns)
+                let t_ns = (t.samples_served > 0).then(|| rate.sample_time_ns(t.last_served_index));
+                let t = *t;
+                log.write(move |log| log.telemetry(host_ns, seq, &t, t_ns))
             }
             DeviceMessage::RegisterWrites { dropped, writes } => {
-                log.register_writes(host_ns, *dropped, writes)
+                let (dropped, writes) = (*dropped, writes.clone());
+                log.write(move |log| log.register_writes(host_ns, dropped, &writes))
             }
-            DeviceMessage::HelloAck(a) => log.event(host_ns, "hello_ack", &describe_ack(a)),
+            DeviceMessage::HelloAck(a) => {
+                let detail = describe_ack(a);
+                log.write(move |log| log.event(host_ns, "hello_ack", &detail))
+            }
             DeviceMessage::Reset(r) => {
-                log.event(host_ns, "device_reset", &format!("{:?}", r.cause))
+                let detail = format!("{:?}", r.cause);
+                log.write(move |log| log.event(host_ns, "device_reset", &detail))
             }
-            DeviceMessage::Error(e) => log.event(host_ns, "device_error", &describe_error(e)),
+            DeviceMessage::Error(e) => {
+                let detail = describe_error(e);
+                log.write(move |log| log.event(host_ns, "device_error", &detail))
+            }
             DeviceMessage::Served {
                 first_index,
                 first_time_ns,
@@ -222,9 +235,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             } => self.log_served(host_ns, *first_index, *first_time_ns, samples),
             DeviceMessage::Credit(_) => Ok(()),
         };
-        written
-            .and_then(|()| self.session.log.flush())
-            .map_err(self.log_err())?;
+        written.map_err(self.log_err())?;
         match message {
             DeviceMessage::Credit(c) => {
                 self.window(c);
@@ -269,17 +280,20 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         samples: &[ServedSample],
     ) -> std::io::Result<()> {
         let rate = self.session.rate;
-        for (k, entry) in (first_index..).zip(samples) {
-            let time_ns = match k == first_index {
-                true => first_time_ns,
-                false => rate.sample_time_ns(k),
-            };
-            let matches = self.served.observe(k, entry);
-            self.session
-                .log
-                .served(host_ns, k, time_ns, entry, matches)?;
-        }
-        Ok(())
+        let rows: Vec<_> = (first_index..)
+            .zip(samples)
+            .map(|(k, entry)| {
+                let time_ns = match k == first_index {
+                    true => first_time_ns,
+                    false => rate.sample_time_ns(k),
+                };
+                (k, time_ns, *entry, self.served.observe(k, entry))
+            })
+            .collect();
+        self.session.log.write(move |log| {
+            rows.iter()
+                .try_for_each(|(k, t, entry, m)| log.served(host_ns, *k, *t, entry, *m))
+        })
     }
 
     /// Goes back to `next_index` if the device, in a report generated at its scene time
@@ -346,11 +360,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             return Err(StreamError::Unsupported { reason });
         }
         let device = device_meta(&ack);
-        let meta = self.session.log.dir().join("meta.toml");
-        let appended = std::fs::OpenOptions::new()
-            .append(true)
-            .open(&meta)
-            .and_then(|mut f| f.write_all(device.as_bytes()));
+        let appended = self.session.log.write(move |log| log.append_meta(&device));
         appended.map_err(self.log_err())
     }
 

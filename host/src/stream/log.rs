@@ -1,6 +1,7 @@
-//! The session directory: one folder per run, CSV files with a header row, flushed after every
-//! batch and every device message, so an interrupted run (Ctrl-C, a vanished device) leaves every
-//! row written so far readable.
+//! The session directory: one folder per run, CSV files with a header row. During a session the
+//! files are written by their own thread (`Logger`), flushed whenever it has written what was
+//! queued (after every batch and every device message, unless the disk is slower), so an
+//! interrupted run (Ctrl-C, a vanished device) leaves every row so far readable.
 //!
 //! Host times (`host_ns`, `send_ns`) are nanoseconds on the host's monotonic clock since the
 //! session opened the port; `meta.toml`'s `start_host_ns` says when Start was sent, which is scene
@@ -85,6 +86,14 @@ impl SessionLog {
     /// The session directory.
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// Appends `text` to `meta.toml`.
+    pub fn append_meta(&mut self, text: &str) -> io::Result<()> {
+        let mut meta = std::fs::OpenOptions::new()
+            .append(true)
+            .open(self.dir.join("meta.toml"))?;
+        meta.write_all(text.as_bytes())
     }
 
     /// Writes `truth.csv` in one go.

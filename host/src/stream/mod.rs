@@ -30,6 +30,7 @@
 mod flow;
 pub mod images;
 pub mod log;
+mod logger;
 mod meta;
 pub mod model;
 mod pacing;

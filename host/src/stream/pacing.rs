@@ -6,7 +6,7 @@
 //! its buffer. The batch starting at item `j` is due at `start + t_j − lead`, where the lead is
 //! `StreamConfig::lead` capped at 3/8 of the device's buffer (so a due batch normally finds the
 //! credit it needs: the device grants its window a quarter of its buffer at a time). The last
-//! 200 µs before a due instant are busy-waited.
+//! 200 µs before a due instant are busy-waited. Stop: see [`Run::finish`].
 
 use super::flow::Run;
 use super::Progress;
@@ -75,10 +75,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         }
         self.next += n;
         let late_ns = late_ns.filter(|_| !resend);
-        let logged = self
-            .session
-            .log_sent(first, n, send_ns, late_ns, resend)
-            .and_then(|()| self.session.log.flush());
+        let logged = self.session.log_sent(first, n, send_ns, late_ns, resend);
         logged.map_err(self.log_err())
     }
 
@@ -155,8 +152,27 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         self.write_batch(n, Some(late), paced)
     }
 
-    /// Sends Stop half an output period after the last sample's instant (so the device serves
-    /// it and no instant after it), then waits for Telemetry in the stopped state.
+    /// Waits until the device reports serving sample `last` (a Served entry or a Telemetry), or
+    /// `deadline`.
+    fn await_served(&mut self, last: u64, deadline: Instant) -> Result<(), StreamError> {
+        let served = |run: &Self| {
+            run.served.stats().last_index >= Some(last)
+                || run
+                    .telemetry
+                    .is_some_and(|t| t.samples_served > 0 && t.last_served_index >= last)
+        };
+        while !served(self) && Instant::now() < deadline {
+            self.pump(deadline)?;
+        }
+        Ok(())
+    }
+
+    /// Sends Stop half an output period after the last sample's instant, on the host's clock.
+    /// In source images the device then serves what it still holds and stops (a graceful
+    /// stop), so it serves the last sample and no instant after it. In source model it stops at
+    /// once, and its clock lags the host's by the Start's delivery time, so the host first waits
+    /// until the device reports serving the last sample (the instants served meanwhile are
+    /// after the scene's end). Then it waits for Telemetry in the stopped state.
     pub(super) fn finish(&mut self) -> Result<(), StreamError> {
         let total = self.total();
         let drain = self.session.config.drain_timeout;
@@ -175,6 +191,9 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             }
             while Instant::now() < stop_at {
                 std::hint::spin_loop();
+            }
+            if self.session.stops_at_once() {
+                self.await_served(last, Instant::now() + drain)?;
             }
         }
         self.stop_sent = true;

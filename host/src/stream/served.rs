@@ -40,6 +40,8 @@ pub struct ServedStats {
     pub unreported: u64,
     /// Entries for instants after the scene's last sample (served before Stop arrived).
     pub after_end: u64,
+    /// The highest index reported.
+    pub last_index: Option<u64>,
 }
 
 impl ServedStats {
@@ -77,6 +79,7 @@ impl ServedCheck {
     pub fn observe(&mut self, index: u64, entry: &ServedSample) -> Option<bool> {
         let s = &mut self.stats;
         s.reported += 1;
+        s.last_index = s.last_index.max(Some(index));
         let Some(&expected) = usize::try_from(index)
             .ok()
             .and_then(|i| self.expected.get(i))

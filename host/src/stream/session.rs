@@ -4,6 +4,7 @@
 use super::flow::Run;
 use super::images::{predict, ImageSettings, PredictedSample};
 use super::log::{SessionLog, SENT_COLUMNS, SENT_KINEMATICS_COLUMNS};
+use super::logger::Logger;
 use super::meta::metadata;
 use super::model::predict_model;
 use super::rx;
@@ -65,8 +66,8 @@ pub struct StreamConfig {
     /// The session number sent in Hello.
     pub session_id: u32,
     /// How long after its write an item missing from a device report counts as lost and is
-    /// sent again (go-back-N): the transfer's latency. Over a UART, add the line time of a
-    /// batch (`margemu stream` does).
+    /// sent again (go-back-N): the transfer's latency (a loaded machine's PTY can take several
+    /// ms to deliver). Over a UART, add the line time of a batch (`margemu stream` does).
     pub resend_after: Duration,
 }
 
@@ -77,7 +78,7 @@ impl Default for StreamConfig {
             baud: 921_600,
             images: None,
             source: SourceMode::Images,
-            lead: Duration::from_millis(50),
+            lead: Duration::from_millis(200),
             batch: 32,
             telemetry_period: Duration::from_millis(20),
             hello_timeout: Duration::from_secs(2),
@@ -85,7 +86,7 @@ impl Default for StreamConfig {
             drain_timeout: Duration::from_secs(1),
             spin: Duration::from_micros(200),
             session_id: 0x6D61_7267, // "marg"
-            resend_after: Duration::from_millis(3),
+            resend_after: Duration::from_millis(20),
         }
     }
 }
@@ -97,7 +98,7 @@ pub struct Session {
     pub(super) rate: Rate,
     pub(super) samples: Vec<PredictedSample>,
     pub(super) items: Items,
-    pub(super) log: SessionLog,
+    pub(super) log: Logger,
     pub(super) stop: Arc<AtomicBool>,
 }
 
@@ -133,6 +134,7 @@ impl Session {
         let log = SessionLog::create(dir, &meta, sent_columns).map_err(log_err)?;
         log.write_truth(samples.iter().map(|s| &s.truth))
             .map_err(log_err)?;
+        let log = Logger::spawn(log).map_err(log_err)?;
         Ok(Self {
             config,
             settings,
@@ -196,8 +198,8 @@ impl Session {
         };
         let logged = self
             .log
-            .event(end_ns, event, &detail)
-            .and_then(|()| self.log.flush());
+            .write(move |log| log.event(end_ns, event, &detail))
+            .and_then(|()| self.log.finish());
         result?;
         logged.map_err(|source| StreamError::Log {
             path: self.log.dir().to_path_buf(),

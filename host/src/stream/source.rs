@@ -41,6 +41,12 @@ impl Session {
         }
     }
 
+    /// Whether the device stops at once on Stop (source model) rather than serving what it
+    /// holds first (source images).
+    pub(super) fn stops_at_once(&self) -> bool {
+        matches!(self.items, Items::Kinematics { .. })
+    }
+
     /// Items to stream.
     pub(super) fn stream_len(&self) -> u64 {
         match &self.items {
@@ -142,21 +148,27 @@ impl Session {
         resend: bool,
     ) -> io::Result<()> {
         let rate = self.item_rate();
-        for j in first..first + n {
-            let t_ns = rate.sample_time_ns(j);
-            match &self.items {
-                Items::Images => {
-                    let image = &self.samples[j as usize].image;
-                    self.log
-                        .sent_image(j, t_ns, send_ns, late_ns, image, resend)?
-                }
-                Items::Kinematics { samples, .. } => {
-                    let k = &samples[j as usize];
-                    self.log
-                        .sent_kinematics(j, t_ns, send_ns, late_ns, k, resend)?
-                }
+        let rows = first..first + n;
+        let range = first as usize..(first + n) as usize;
+        match &self.items {
+            Items::Images => {
+                let images: Vec<Image> = self.samples[range].iter().map(|s| s.image).collect();
+                self.log.write(move |log| {
+                    rows.zip(&images).try_for_each(|(j, image)| {
+                        let t_ns = rate.sample_time_ns(j);
+                        log.sent_image(j, t_ns, send_ns, late_ns, image, resend)
+                    })
+                })
+            }
+            Items::Kinematics { samples, .. } => {
+                let kinematics = samples[range].to_vec();
+                self.log.write(move |log| {
+                    rows.zip(&kinematics).try_for_each(|(j, k)| {
+                        let t_ns = rate.sample_time_ns(j);
+                        log.sent_kinematics(j, t_ns, send_ns, late_ns, k, resend)
+                    })
+                })
             }
         }
-        Ok(())
     }
 }
