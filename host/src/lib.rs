@@ -13,13 +13,15 @@
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
 //! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
-//! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs.
+//! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs;
+//! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged.
 #![warn(missing_docs)]
 
 pub mod analysis;
 pub mod bench;
 pub mod bus;
 pub mod csv_column;
+pub mod dut;
 pub mod loopback;
 pub mod marg;
 pub mod motion;
