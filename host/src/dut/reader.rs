@@ -191,10 +191,15 @@ impl Worker {
             if let Some(requests) = &poll {
                 let now = Instant::now();
                 if now >= next_poll {
-                    if let Err(e) = port.write_all(requests).and_then(|()| port.flush()) {
-                        return Ok(DutEnd::Disconnected(format!("writing to the port: {e}")));
+                    match port.write_all(requests).and_then(|()| port.flush()) {
+                        Ok(()) => self.requests_sent += 2,
+                        // A board that does not read fills the line: this poll is dropped
+                        // (a partial request is a false start to the board's parser).
+                        Err(e) if is_transient(&e) => {}
+                        Err(e) => {
+                            return Ok(DutEnd::Disconnected(format!("writing to the port: {e}")))
+                        }
                     }
-                    self.requests_sent += 2;
                     next_poll = (next_poll + period).max(now);
                 }
             }
