@@ -4,7 +4,7 @@
 
 mod dut_support;
 
-use dut_support::{close, num, nums, pty, rows, session_dir, wait_for, Stream};
+use dut_support::{close, num, nums, pty, quat_of, rows, session_dir, wait_for, Stream};
 use margemu::dut::log::{
     ATTITUDE_COLUMNS, ATTITUDE_FILE, IMU_COLUMNS, IMU_FILE, MESSAGES_COLUMNS, MESSAGES_FILE,
 };
@@ -12,8 +12,8 @@ use margemu::dut::mavlink_out::{attitude, attitude_quaternion, MavlinkWriter};
 use margemu::dut::{spawn_dut_reader, DutEnd, DutProtocol};
 use margemu::truth::geodesic_angle;
 use mavlink::dialects::common::{
-    HighresImuUpdatedFlags, MavMessage, ATTITUDE_DATA, ATTITUDE_QUATERNION_DATA,
-    HIGHRES_IMU_DATA, SCALED_IMU_DATA, SYSTEM_TIME_DATA,
+    HighresImuUpdatedFlags, MavMessage, ATTITUDE_DATA, ATTITUDE_QUATERNION_DATA, HIGHRES_IMU_DATA,
+    SCALED_IMU_DATA, SYSTEM_TIME_DATA,
 };
 use mavlink::{MavHeader, MavlinkVersion, Message};
 use std::time::Instant;
@@ -105,19 +105,6 @@ fn euler_of(q: [f64; 4]) -> [f64; 3] {
         (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y)),
         (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin(),
         (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z)),
-    ]
-}
-
-/// The quaternion of ZYX Euler angles (half-angle formula, as truth.rs).
-fn quat_of(e: [f64; 3]) -> [f64; 4] {
-    let (sp, cp) = (0.5 * e[0]).sin_cos();
-    let (st, ct) = (0.5 * e[1]).sin_cos();
-    let (ss, cs) = (0.5 * e[2]).sin_cos();
-    [
-        cp * ct * cs + sp * st * ss,
-        sp * ct * cs - cp * st * ss,
-        cp * st * cs + sp * ct * ss,
-        cp * ct * ss - sp * st * cs,
     ]
 }
 
@@ -243,7 +230,11 @@ fn mavlink_1_and_2_in_random_pieces_with_garbage_decode_exactly() {
             _ => continue,
         };
         let sample = sample.expect("a sample row for each sample message");
-        assert_eq!(&sample[..3], &row[..3], "same receive time, protocol, message");
+        assert_eq!(
+            &sample[..3],
+            &row[..3],
+            "same receive time, protocol, message"
+        );
         match e.message {
             MavMessage::ATTITUDE(_) | MavMessage::ATTITUDE_QUATERNION(_) => {
                 check_attitude(sample, &e.message)
@@ -266,7 +257,9 @@ fn a_vanishing_port_ends_the_reader_with_its_rows_intact() {
     }
     wait_for(&reader, |p| p.messages == 10);
     // Half a frame, then the device is gone.
-    let half = fc.encode(&attitude(10, [1.0, 0.0, 0.0, 0.0], [0.0; 3])).unwrap();
+    let half = fc
+        .encode(&attitude(10, [1.0, 0.0, 0.0, 0.0], [0.0; 3]))
+        .unwrap();
     dut_support::write_fully(&mut device, &half[..half.len() / 2]);
     drop(device);
     let deadline = Instant::now() + std::time::Duration::from_secs(5);
@@ -483,7 +476,10 @@ fn pymavlink_frames_decode() {
     for (i, row) in messages.iter().enumerate() {
         let m = pymavlink_message(i as u32);
         let wire = if i % 3 == 0 { "mavlink1" } else { "mavlink2" };
-        assert_eq!(&row[1..6], [wire, m.message_name(), "7", "3", &i.to_string()]);
+        assert_eq!(
+            &row[1..6],
+            [wire, m.message_name(), "7", "3", &i.to_string()]
+        );
         let sample = if i % 4 < 2 {
             &attitude[i / 4 * 2 + i % 4]
         } else {

@@ -5,7 +5,7 @@
 
 mod dut_support;
 
-use dut_support::{close, nums, pty, rows, session_dir, wait_for, Stream};
+use dut_support::{close, nums, pty, quat_of, rows, session_dir, wait_for, Stream};
 use margemu::dut::log::{
     ATTITUDE_COLUMNS, ATTITUDE_FILE, IMU_COLUMNS, IMU_FILE, MESSAGES_COLUMNS, MESSAGES_FILE,
 };
@@ -55,25 +55,7 @@ fn le(values: &[i16]) -> Vec<u8> {
 fn msp_euler(roll: i16, pitch: i16, heading: i16) -> [f64; 3] {
     let yaw = -f64::from(heading);
     let yaw = if yaw <= -180.0 { yaw + 360.0 } else { yaw };
-    [
-        f64::from(roll) / 10.0,
-        f64::from(pitch) / 10.0,
-        yaw,
-    ]
-    .map(f64::to_radians)
-}
-
-/// The quaternion of ZYX Euler angles (half-angle formula, as truth.rs).
-fn quat_of(e: [f64; 3]) -> [f64; 4] {
-    let (sp, cp) = (0.5 * e[0]).sin_cos();
-    let (st, ct) = (0.5 * e[1]).sin_cos();
-    let (ss, cs) = (0.5 * e[2]).sin_cos();
-    [
-        cp * ct * cs + sp * st * ss,
-        sp * ct * cs - cp * st * ss,
-        cp * st * cs + sp * ct * ss,
-        cp * ct * ss - sp * st * cs,
-    ]
+    [f64::from(roll) / 10.0, f64::from(pitch) / 10.0, yaw].map(f64::to_radians)
 }
 
 fn check_attitude_row(row: &[String], (roll, pitch, heading): (i16, i16, i16)) {
@@ -191,7 +173,12 @@ fn betaflight_attitude_signs_through_the_whole_path() {
         1e-15,
         "east",
     );
-    close(&nums::<3>(&attitude[1], 4), &[0.0, 0.0, d(90.0)], 1e-15, "west");
+    close(
+        &nums::<3>(&attitude[1], 4),
+        &[0.0, 0.0, d(90.0)],
+        1e-15,
+        "west",
+    );
 }
 
 /// What the board played by a test thread saw and answered.
@@ -207,7 +194,8 @@ struct Board {
 /// A board answering MSP_ATTITUDE and MSP_RAW_IMU requests in `version` until `stop`.
 fn board(mut port: TTYPort, version: MspVersion, stop: Arc<AtomicBool>) -> JoinHandle<Board> {
     use serialport::SerialPort;
-    port.set_timeout(std::time::Duration::from_millis(2)).unwrap();
+    port.set_timeout(std::time::Duration::from_millis(2))
+        .unwrap();
     std::thread::spawn(move || {
         let mut parser = MspParser::new();
         let mut b = Board::default();

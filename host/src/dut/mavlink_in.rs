@@ -19,8 +19,7 @@ use mavlink::dialects::common::{
     MavMessage, ATTITUDE_DATA, ATTITUDE_QUATERNION_DATA, HIGHRES_IMU_DATA,
 };
 use mavlink::{
-    consts, MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavlinkVersion, Message, MAV_STX,
-    MAV_STX_V2,
+    consts, MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavlinkVersion, Message, MAV_STX, MAV_STX_V2,
 };
 use std::borrow::Cow;
 
@@ -47,7 +46,13 @@ struct Layout {
 }
 
 fn layout(b: &[u8]) -> Result<Layout, Candidate> {
-    let need = |n: usize| if b.len() < n { Err(Candidate::Incomplete) } else { Ok(()) };
+    let need = |n: usize| {
+        if b.len() < n {
+            Err(Candidate::Incomplete)
+        } else {
+            Ok(())
+        }
+    };
     if b[0] == MAV_STX {
         need(6)?;
         return Ok(Layout {
@@ -182,15 +187,21 @@ fn sample_of(m: &MavMessage) -> Option<Sample> {
         }),
         MavMessage::SCALED_IMU(d) => scaled_imu(
             d.time_boot_ms,
-            [d.xacc, d.yacc, d.zacc, d.xgyro, d.ygyro, d.zgyro, d.xmag, d.ymag, d.zmag],
+            [
+                d.xacc, d.yacc, d.zacc, d.xgyro, d.ygyro, d.zgyro, d.xmag, d.ymag, d.zmag,
+            ],
         ),
         MavMessage::SCALED_IMU2(d) => scaled_imu(
             d.time_boot_ms,
-            [d.xacc, d.yacc, d.zacc, d.xgyro, d.ygyro, d.zgyro, d.xmag, d.ymag, d.zmag],
+            [
+                d.xacc, d.yacc, d.zacc, d.xgyro, d.ygyro, d.zgyro, d.xmag, d.ymag, d.zmag,
+            ],
         ),
         MavMessage::SCALED_IMU3(d) => scaled_imu(
             d.time_boot_ms,
-            [d.xacc, d.yacc, d.zacc, d.xgyro, d.ygyro, d.zgyro, d.xmag, d.ymag, d.zmag],
+            [
+                d.xacc, d.yacc, d.zacc, d.xgyro, d.ygyro, d.zgyro, d.xmag, d.ymag, d.zmag,
+            ],
         ),
         MavMessage::HIGHRES_IMU(d) => highres_imu(d),
         _ => return None,

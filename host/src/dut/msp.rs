@@ -19,7 +19,7 @@
 //!
 //! | command | payload | becomes |
 //! |---|---|---|
-//! | `MSP_ATTITUDE` (108) | roll i16 (0.1°), pitch i16 (0.1°), yaw i16 (heading, whole degrees 0..359) | an attitude via [`from_msp`](super::frames::from_msp) |
+//! | `MSP_ATTITUDE` (108) | roll i16 (0.1°), pitch i16 (0.1°), yaw i16 (heading, whole degrees 0..359) | an attitude via [`from_msp`] |
 //! | `MSP_RAW_IMU` (102) | acc, gyro, mag: 3 × i16 each | an IMU row of **raw counts**, written unscaled and unrotated |
 //!
 //! `MSP_RAW_IMU`'s units depend on the firmware: Betaflight sends the accelerometer in its ADC

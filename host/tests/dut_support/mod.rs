@@ -146,3 +146,16 @@ pub fn close(actual: &[f64], expected: &[f64], tol: f64, what: &str) {
         );
     }
 }
+
+/// The quaternion of ZYX Euler angles (half-angle formula, as truth.rs).
+pub fn quat_of(e: [f64; 3]) -> [f64; 4] {
+    let (sp, cp) = (0.5 * e[0]).sin_cos();
+    let (st, ct) = (0.5 * e[1]).sin_cos();
+    let (ss, cs) = (0.5 * e[2]).sin_cos();
+    [
+        cp * ct * cs + sp * st * ss,
+        sp * ct * cs - cp * st * ss,
+        cp * st * cs + sp * ct * ss,
+        cp * ct * ss - sp * st * cs,
+    ]
+}
