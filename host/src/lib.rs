@@ -15,6 +15,7 @@
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
 //! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs;
 //! - [`evaluate`](mod@evaluate): scores of a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned and split by phase.
+//! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged.
 #![warn(missing_docs)]
 
 pub mod analysis;
@@ -22,6 +23,7 @@ pub mod bench;
 pub mod bus;
 pub mod csv_column;
 pub mod evaluate;
+pub mod dut;
 pub mod loopback;
 pub mod marg;
 pub mod motion;
