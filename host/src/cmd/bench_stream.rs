@@ -19,9 +19,10 @@ pub struct Cmd {
         default_value = "1000,2000,4000,8000,16000,32000,64000,128000,256000"
     )]
     rates: Vec<f64>,
-    /// Where the sessions' logs go (one directory per row).
-    #[arg(long, default_value = "sessions/bench-stream")]
-    output: PathBuf,
+    /// Keep the sessions' logs here (one directory per row; at 256 kHz a row writes about a GB).
+    /// Without it they go to a temporary directory, removed after each row.
+    #[arg(long)]
+    keep: Option<PathBuf>,
 }
 
 impl Cmd {
@@ -42,18 +43,25 @@ impl Cmd {
              the CRC-32C of every image it served against the host's prediction. Lost = scene \
              samples not served byte for byte (underruns, mismatches, unreported). Pacing: how \
              late each batch's write started against the scene clock; written: how late it \
-             completed (the PTY write included). Logs in {}.\n",
+             completed (the PTY write included).\n",
             self.seconds,
             margemu::loopback::BUFFER,
-            self.output.display()
         );
         println!(
             "| source | rate (Hz) | samples | sent | served byte-exact | lost | of which mismatched | lead (ms) | batch | pacing late p50 / p99 / max (µs) | written late p50 / p99 / max (µs) | credit stalls | resends | link efficiency |"
         );
         println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-        let rows = stream_sweep(&self.rates, &sources, self.seconds, &self.output)?;
-        for r in &rows {
-            print_row(r);
+        let dir = self.keep.clone().unwrap_or_else(|| {
+            std::env::temp_dir().join(format!("margemu-bench-stream-{}", std::process::id()))
+        });
+        for &source in &sources {
+            for &rate in &self.rates {
+                let row = stream_sweep(&[rate], &[source], self.seconds, &dir)?;
+                if self.keep.is_none() {
+                    std::fs::remove_dir_all(&dir)?;
+                }
+                row.iter().for_each(print_row);
+            }
         }
         println!(
             "\nWorst-case link efficiency of a batch frame (header, first index, items, CRC, \
