@@ -39,6 +39,7 @@ fn long_run(duration: f64, rate: f64) {
         summary.credit_stalls,
         summary.resends
     );
+    std::fs::remove_dir_all(&dir).unwrap(); // tens of MB; kept only when the test fails
 }
 
 #[test]

@@ -2,6 +2,7 @@
 
 pub mod analyze;
 pub mod bench;
+mod bench_stream;
 pub mod evaluate;
 pub mod loopback;
 pub mod ports;

@@ -38,6 +38,8 @@ pub(super) struct Run<'s, W: Write, P: FnMut(&Progress)> {
     pub(super) served: ServedCheck,
     /// Lateness of each paced batch, ns.
     pub(super) late: Vec<i64>,
+    /// Lateness of the same batches when their write completed, ns.
+    pub(super) written_late: Vec<i64>,
     pub(super) max_late_ns: i64,
     pub(super) credit_stalls: u64,
     /// The next item to write.
@@ -83,6 +85,7 @@ impl<'s, W: Write, P: FnMut(&Progress)> Run<'s, W, P> {
             host_rx: RxStats::default(),
             served,
             late: Vec::with_capacity(total / 8 + 1),
+            written_late: Vec::with_capacity(total / 8 + 1),
             max_late_ns: 0,
             credit_stalls: 0,
             next: 0,
@@ -422,6 +425,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             dir: self.session.log.dir().to_path_buf(),
             start_host_ns: self.start.map(|s| self.host_ns(s)),
             jitter: JitterStats::from_lateness(&self.late),
+            written_jitter: JitterStats::from_lateness(&self.written_late),
             telemetry: self.telemetry,
             device: self.ack,
             host_rx: self.host_rx,

@@ -153,8 +153,9 @@ pub struct Progress {
     pub served: ServedStats,
 }
 
-/// Pacing jitter: how late each batch was written against its schedule, over the batches
-/// written after Start that did not wait for credit (those count as credit stalls).
+/// Pacing jitter: how late batches were written against their schedule, over the batches
+/// written after Start that did not wait for credit (those count as credit stalls) and were
+/// not resends.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct JitterStats {
     /// Batches measured.
@@ -235,8 +236,11 @@ pub struct Summary {
     pub dir: PathBuf,
     /// When Start was written, ns since the port was opened (scene time 0).
     pub start_host_ns: Option<i64>,
-    /// Pacing jitter.
+    /// Pacing jitter: how late each paced batch's write started against the scene clock.
     pub jitter: JitterStats,
+    /// How late the same writes completed (the port's time added: a PTY write wakes the
+    /// reader).
+    pub written_jitter: JitterStats,
     /// The device's last Telemetry.
     pub telemetry: Option<Telemetry>,
     /// The device's HelloAck.

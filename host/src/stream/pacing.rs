@@ -50,16 +50,19 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         )
     }
 
-    /// Writes items `next .. next + n`; `late_ns` is how late against schedule (`None`: not
-    /// paced, or a resend), and a `paced` batch counts in the jitter figures.
+    /// Writes items `next .. next + n`. A batch `due` at an instant is logged with how late its
+    /// write completed against it; for a `paced` one (not held back by credit, not a resend) the
+    /// jitter figures keep how late the write started (the pacing) and completed (the port's
+    /// share added).
     fn write_batch(
         &mut self,
         n: u64,
-        late_ns: Option<i64>,
+        due: Option<Instant>,
         paced: bool,
     ) -> Result<(), StreamError> {
         let first = self.next;
         let resend = first < self.go_back.high();
+        let started = Instant::now();
         let len = self
             .session
             .emit_batch(first, n, &mut self.encoder, &mut self.wire);
@@ -67,11 +70,15 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         self.link.batch_frames += 1;
         self.link.batch_wire_bytes += len as u64;
         self.link.item_bytes += n * self.session.item_len();
-        let send_ns = self.host_ns(Instant::now());
+        let sent_at = Instant::now();
+        let send_ns = self.host_ns(sent_at);
+        let late_ns = due.map(|due| sent_at.saturating_duration_since(due).as_nanos() as i64);
         self.go_back.written(first, n, send_ns);
-        if let (Some(l), true) = (late_ns, paced && !resend) {
-            self.late.push(l);
-            self.max_late_ns = self.max_late_ns.max(l);
+        if let (Some(due), true) = (due, paced && !resend) {
+            let late = |at: Instant| at.saturating_duration_since(due).as_nanos() as i64;
+            self.late.push(late(started));
+            self.written_late.push(late(sent_at));
+            self.max_late_ns = self.max_late_ns.max(late(started));
         }
         self.next += n;
         let late_ns = late_ns.filter(|_| !resend);
@@ -123,8 +130,12 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         while Instant::now() < due {
             std::hint::spin_loop();
         }
-        while let Ok(event) = self.events.try_recv() {
-            self.handle(event)?;
+        // The batch goes out first; device messages wait, unless the window is short.
+        let wanted = self.batch.min(total - self.next);
+        if self.credit.available(self.next) < wanted {
+            while let Ok(event) = self.events.try_recv() {
+                self.handle(event)?;
+            }
         }
         let available = self.credit.available(self.next);
         if available == 0 {
@@ -148,8 +159,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         if self.next < self.go_back.high() {
             n = n.min(self.go_back.high() - self.next);
         }
-        let late = Instant::now().saturating_duration_since(due).as_nanos() as i64;
-        self.write_batch(n, Some(late), paced)
+        self.write_batch(n, Some(due), paced)
     }
 
     /// Waits until the device reports serving sample `last` (a Served entry or a Telemetry), or
