@@ -9,7 +9,7 @@
 //! of its loop waits up to 1 ms for bytes, feeds every byte that has arrived
 //! ([`Device::feed`], as a UART interrupt would have), then serves the sample instants that are
 //! due and sends what the device has to say ([`Device::poll`]), on a monotonic clock. The host
-//! side is an ordinary [`Session`](crate::stream::Session) on the other end; it checks the
+//! side is an ordinary [`Session`] on the other end; it checks the
 //! device's own Served reports against its prediction.
 
 use crate::scene::Scene;

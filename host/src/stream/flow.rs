@@ -240,17 +240,11 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         };
         written.map_err(self.log_err())?;
         match message {
-            DeviceMessage::Credit(c) => {
-                self.window(c);
-                let capacity = self.ack.map_or(0, |a| a.capabilities.buffer_capacity);
-                let tau = self.session.credit_time_ns(c.limit, u64::from(capacity));
-                self.check_lost(c.next_index, tau)?;
-            }
+            DeviceMessage::Credit(c) => self.window(c),
             DeviceMessage::Telemetry(t) => {
                 self.window(t.credit());
                 self.telemetry = Some(t);
-                let running = t.state == DeviceState::Running;
-                self.check_lost(t.next_index, running.then_some(t.time_ns))?;
+                self.check_lost(&t)?;
             }
             DeviceMessage::HelloAck(a) if a.session == self.session.config.session_id => {
                 self.ack = Some(a);
@@ -299,19 +293,31 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         })
     }
 
-    /// Goes back to `next_index` if the device, in a report generated at its scene time
-    /// `tau_ns` or later, still misses an item written long enough before (see [`super::resend`]).
-    fn check_lost(&mut self, next_index: u64, tau_ns: Option<u64>) -> Result<(), StreamError> {
-        let (Some(start), Some(tau), false) = (self.start, tau_ns, self.stop_sent) else {
+    /// Goes back to the device's `next_index` if its Telemetry shows that item lost: the device
+    /// holds items beyond it, which a FIFO line delivered after it (or, once every item was
+    /// written, nothing more is coming), and it was last written long enough before the report
+    /// (see [`super::resend`]).
+    fn check_lost(&mut self, t: &Telemetry) -> Result<(), StreamError> {
+        let capacity = self
+            .ack
+            .map_or(0, |a| u64::from(a.capabilities.buffer_capacity));
+        let contiguous = t
+            .next_index
+            .saturating_sub(t.credit_limit.saturating_sub(capacity));
+        let all_written = self.go_back.high() == self.session.stream_len();
+        let beyond = u64::from(t.buffer_level) > contiguous || all_written;
+        let running = t.state == DeviceState::Running;
+        let (Some(start), true, true, false) = (self.start, running, beyond, self.stop_sent) else {
             return Ok(());
         };
+        let (next_index, tau) = (t.next_index, t.time_ns);
         let margin = self.session.config.resend_after.as_nanos() as i64;
         let seen_by = self.host_ns(start) + tau as i64 - margin;
         match self.go_back.lost(next_index, seen_by) {
             Some(hole) if hole < self.next => {
                 let detail = format!(
-                    "device next_index {hole} at its scene time {tau} ns; going back from {}",
-                    self.next
+                    "device next_index {hole} at its scene time {tau} ns, {} items buffered; going back from {}",
+                    t.buffer_level, self.next
                 );
                 self.next = hole;
                 self.go_back.rewound();

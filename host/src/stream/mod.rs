@@ -1,21 +1,26 @@
-//! Real-time streaming of a scene to a device over a serial port (issue 5, source mode (a):
-//! register images).
+//! Real-time streaming of a scene to a device over a serial port (issue 5), in either source
+//! mode of `docs/spec/link.md`: (a) register images, (b) true kinematics for the device's own
+//! sensor model.
 //!
-//! A [`Session`] predicts every register image of a validated [`Scene`](crate::scene::Scene)
-//! ([`predict`]: truth → [`MargSim`](crate::marg::MargSim) → [`ImageRepr::from_physical`] with an
-//! explicit [`ImageSettings`]), then speaks the link protocol of `docs/spec/link.md` over any
-//! byte port:
+//! A [`Session`] first predicts every register image the device will serve for a validated
+//! [`Scene`](crate::scene::Scene): in mode (a) [`predict`] (truth →
+//! [`MargSim`](crate::marg::MargSim) → [`ImageRepr::from_physical`] with an explicit
+//! [`ImageSettings`]), in mode (b) [`predict_model`] (the firmware's zero-order hold of the
+//! kinematics and model steps, see [`model`]; scenes the device cannot run are refused here,
+//! before anything is sent). Then it speaks the link protocol over any byte port:
 //!
 //! 1. Hello → HelloAck: the protocol version must match, and the device must emulate the
-//!    MPU-9250 and take register images;
-//! 2. Configure (WHO_AM_I 0x71, the scene's exact rate, source "images") → the first Credit;
-//! 3. prefill (the samples due within the lead, as far as the window allows), then Start
+//!    MPU-9250 and support the source mode;
+//! 2. Configure (WHO_AM_I 0x71, the scene's exact rate, the source and, in mode (b), the model
+//!    parameters) → the first Credit;
+//! 3. prefill (the items due within the lead, as far as the window allows), then Start
 //!    (`t0_ns` = 0), which sets scene time 0 on the host's monotonic clock;
-//! 4. batches paced in real time: the batch that starts at sample `k` is written at
-//!    `start + t_k − lead`, never beyond the device's credit window; the time of every write and
-//!    how late it was against that schedule are logged (pacing jitter);
-//! 5. after the last sample's instant: wait for Telemetry saying it was served, Stop, and wait for
-//!    Telemetry in the stopped state.
+//! 4. batches paced in real time (`pacing.rs`): the batch that starts at
+//!    item `j` is written at `start + t_j − lead`, never beyond the device's credit window; the
+//!    time of every write and how late it was are logged (pacing jitter). Items the device
+//!    reports missing long after they were written are written again ([`resend`]);
+//! 5. Stop after the last sample (in mode (b) once the device reports serving it), then wait
+//!    for Telemetry in the stopped state.
 //!
 //! A receive thread ([`rx`]) decodes the device's frames concurrently and counts damaged ones.
 //! Every sample instant the device reports serving (its Served messages: index, CRC-32C of the
@@ -23,7 +28,8 @@
 //! [`Summary`] carries the counts. The session stops with a [`StreamError`] on a device
 //! Reset after the handshake, a fatal device Error, end of file or an error on the port, a
 //! timeout waiting for HelloAck or credit, or the stop flag (Ctrl-C); in every case the logs
-//! ([`log`]) are flushed and end with an `end` row in `events.csv`.
+//! ([`log`], written by their own thread) are flushed and end with an `end` row in
+//! `events.csv`.
 //!
 //! [`ImageRepr::from_physical`]: margemu_protocol::regmap::image::ImageRepr::from_physical
 

@@ -1,14 +1,19 @@
 //! Go-back-N: resending the items a device did not receive (`docs/spec/link.md` §7).
 //!
-//! Every Credit and Telemetry carries the device's `next_index`: every item below it arrived,
-//! contiguously. A damaged or lost batch leaves a hole there while later batches keep arriving.
-//! The host cannot tell a lost batch from one still in flight by `next_index` alone, so it asks
-//! how late the report is: a report generated at device scene time `τ` (a Telemetry's `time_ns`;
-//! for a Credit, the instant of the last sample it must have served to grant that limit) was
-//! generated no earlier than host time `start + τ`. If the item at `next_index` was last
-//! written before `start + τ − margin` (the margin covers the transfer: a PTY's latency, a
-//! UART's line time), it was lost: the session goes back to `next_index` and writes every item
-//! from there again (the device keeps the first copy of each), within the credit window.
+//! Every Telemetry carries the device's `next_index` (every item below it arrived,
+//! contiguously), its credit window (which starts at the oldest item it holds or serves next)
+//! and how many items it holds. A damaged or lost batch leaves a hole at `next_index` while
+//! later batches keep arriving, so the device then holds more items than the contiguous run
+//! from the window's start: on a line that delivers in order, the hole's batch was lost, not
+//! delayed. (After the last batch, nothing more is coming: the timing condition below decides
+//! alone.) The session then goes back to `next_index` and writes every item from there again
+//! (the device keeps the first copy of each), within the credit window.
+//!
+//! One more condition keeps a resend still in flight from being sent again: the report must
+//! have been generated long enough after the hole's last write. A Telemetry's `time_ns` is the
+//! device's scene time `τ`; it was generated no earlier than host time `start + τ` (the device's
+//! clock starts when it receives Start, after the host's), so the hole must have been written
+//! before `start + τ − margin` (`StreamConfig::resend_after`: the line's delivery time).
 //!
 //! ```
 //! use margemu::stream::resend::GoBackN;
@@ -59,9 +64,9 @@ impl GoBackN {
         self.high
     }
 
-    /// Whether item `next_index`, missing at a device report generated no earlier than host
-    /// time `seen_by_ns` (less the transfer margin), was lost: `Some(next_index)` if it was
-    /// written, last before `seen_by_ns`.
+    /// Whether item `next_index`, missing from a device report generated no earlier than host
+    /// time `seen_by_ns` (less the delivery margin), is due to be written again:
+    /// `Some(next_index)` if it was written, last before `seen_by_ns`.
     pub fn lost(&self, next_index: u64, seen_by_ns: i64) -> Option<u64> {
         let written = *self
             .last_written_ns

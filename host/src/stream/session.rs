@@ -65,9 +65,9 @@ pub struct StreamConfig {
     pub spin: Duration,
     /// The session number sent in Hello.
     pub session_id: u32,
-    /// How long after its write an item missing from a device report counts as lost and is
-    /// sent again (go-back-N): the transfer's latency (a loaded machine's PTY can take several
-    /// ms to deliver). Over a UART, add the line time of a batch (`margemu stream` does).
+    /// Go-back-N: how long after its last write an item the device reports lost (it holds items
+    /// after it) may be written again: the line's delivery time (a loaded machine's PTY can
+    /// take over 10 ms). Over a UART, add the line time of a batch (`margemu stream` does).
     pub resend_after: Duration,
 }
 

@@ -79,19 +79,6 @@ impl Session {
         }
     }
 
-    /// The device scene time by which it must have generated a Credit granting `limit` with a
-    /// buffer of `capacity` items: the instant of the sample it served to move its window
-    /// there (`None` while the window has not moved).
-    pub(super) fn credit_time_ns(&self, limit: u64, capacity: u64) -> Option<u64> {
-        let base = limit.checked_sub(capacity)?;
-        match &self.items {
-            // The window starts after the last image served.
-            Items::Images => base.checked_sub(1).map(|k| self.rate.sample_time_ns(k)),
-            // The window starts at the kinematics sample in effect.
-            Items::Kinematics { params, .. } => Some(params.truth_rate.sample_time_ns(base)),
-        }
-    }
-
     /// The source the device must support.
     pub(super) fn required_mode(&self) -> (Modes, &'static str) {
         match &self.items {
