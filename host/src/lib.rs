@@ -16,14 +16,15 @@
 //! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs;
 //! - [`evaluate`](mod@evaluate): scores of a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned and split by phase.
 //! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged.
+//! - [`vfc`]: a virtual flight controller on the loopback device (the `mpu9250` driver, a reference filter, MAVLink out).
 #![warn(missing_docs)]
 
 pub mod analysis;
 pub mod bench;
 pub mod bus;
 pub mod csv_column;
-pub mod evaluate;
 pub mod dut;
+pub mod evaluate;
 pub mod loopback;
 pub mod marg;
 pub mod motion;
@@ -34,3 +35,4 @@ pub mod run;
 pub mod scene;
 pub mod stream;
 pub mod truth;
+pub mod vfc;

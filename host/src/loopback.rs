@@ -87,15 +87,28 @@ pub fn spawn_device(port: TTYPort) -> std::io::Result<LoopbackDevice> {
 /// announces its reset cause), or end the loop with a reason (the board vanishes: the port is
 /// closed).
 pub fn spawn_device_with(
-    mut port: TTYPort,
-    mut hook: impl FnMut(&mut Firmware, u64) -> ControlFlow<String> + Send + 'static,
+    port: TTYPort,
+    hook: impl FnMut(&mut Firmware, u64) -> ControlFlow<String> + Send + 'static,
 ) -> std::io::Result<LoopbackDevice> {
+    spawn_device_with_local(port, move || hook)
+}
+
+/// [`spawn_device_with`] for a hook that must live in the device thread (it need not be `Send`,
+/// e.g. a driver sharing the chip through `Rc`): `make_hook` builds it there, before the loop.
+pub fn spawn_device_with_local<H>(
+    mut port: TTYPort,
+    make_hook: impl FnOnce() -> H + Send + 'static,
+) -> std::io::Result<LoopbackDevice>
+where
+    H: FnMut(&mut Firmware, u64) -> ControlFlow<String>,
+{
     port.set_timeout(Duration::from_millis(1))?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
     let thread = std::thread::Builder::new()
         .name("loopback-device".into())
         .spawn(move || {
+            let mut hook = make_hook();
             let mut device: Box<Firmware> = Box::default();
             let origin = Instant::now();
             let now = || origin.elapsed().as_nanos() as u64;

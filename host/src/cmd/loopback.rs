@@ -1,9 +1,13 @@
 //! `margemu loopback SCENE [-o DIR]`: the embedded default. The firmware's link handler runs on
 //! the host behind a real pseudo-terminal pair, the scene streams to it exactly as to a board,
-//! and every image the device reports serving is checked against the host's prediction.
+//! and every image the device reports serving is checked against the host's prediction. With
+//! `--dut PORT` a device under test's output is logged beside the session; with `--vfc FILTER`
+//! a virtual flight controller runs on the emulated chip and its MAVLink is read back and scored.
 
-use super::stream::{prepare, stream_to, SourceArgs};
+use super::stream::{finish_dut, prepare, stream_to, DutArgs, SourceArgs};
+use super::vfc::VfcArgs;
 use anyhow::{bail, Context, Result};
+use margemu::dut::{DutConfig, DutProtocol};
 use margemu::scene::Scene;
 use margemu::stream::{ImageSettings, StreamConfig};
 use serialport::{SerialPort, TTYPort};
@@ -18,6 +22,10 @@ pub struct Cmd {
     output: Option<PathBuf>,
     #[command(flatten)]
     source: SourceArgs,
+    #[command(flatten)]
+    dut: DutArgs,
+    #[command(flatten)]
+    vfc: VfcArgs,
 }
 
 impl Cmd {
@@ -27,22 +35,53 @@ impl Cmd {
             let stem = self.scene.file_stem().unwrap_or_default().to_string_lossy();
             PathBuf::from("sessions").join(format!("{stem}-loopback"))
         });
-        let settings = ImageSettings::for_scene(&scene);
+        let vfc = self.vfc.config(&scene)?;
+        let settings = match vfc {
+            Some(_) => margemu::vfc::image_settings(&scene),
+            None => ImageSettings::for_scene(&scene),
+        };
         let (host_end, device_end) = TTYPort::pair().context("opening a pseudo-terminal pair")?;
         let label = device_end
             .name()
             .unwrap_or_else(|| "a pseudo-terminal".into());
-        let device = margemu::loopback::spawn_device(device_end).context("starting the device")?;
         let config = StreamConfig {
             port: label.clone(),
             images: Some(settings),
             source: self.source.mode()?,
             ..StreamConfig::default()
         };
-        let session = prepare(&scene, config, &dir)?;
+        let mut session = prepare(&scene, config, &dir)?;
+        let (device, dut) = match vfc {
+            Some(cfg) => {
+                let expected = margemu::vfc::board::image_config();
+                let (rig, port) = margemu::vfc::spawn(device_end, cfg, expected)?;
+                let config = DutConfig::new(DutProtocol::Mavlink);
+                let dut = margemu::vfc::attach(&mut session, port, config, &dir)?;
+                (Device::Fc(rig), Some(dut))
+            }
+            None => {
+                let device =
+                    margemu::loopback::spawn_device(device_end).context("starting the device")?;
+                (Device::Plain(device), self.dut.attach(&mut session, &dir)?)
+            }
+        };
         let streamed = stream_to(&scene, session, &dir, host_end, &label);
-        let report = device.stop();
+        let (report, fc) = match device {
+            Device::Plain(device) => (device.stop(), None),
+            Device::Fc(rig) => {
+                let fc = rig.stop();
+                (fc.device.clone(), Some(fc))
+            }
+        };
+        if let (Some(dut), Some(fc)) = (&dut, &fc) {
+            dut.wait_for_bytes(fc.uart.bytes, std::time::Duration::from_secs(2));
+        }
+        let dut = dut.map(finish_dut).transpose();
+        if let Some(why) = fc.as_ref().and_then(|fc| fc.fc.error.as_ref()) {
+            eprintln!("the virtual flight controller stopped the device: {why}");
+        }
         let summary = streamed?;
+        let dut = dut?;
         let s = summary.served;
         let overruns = summary.telemetry.map_or(0, |t| t.overruns);
         println!(
@@ -64,6 +103,15 @@ impl Cmd {
                 dir.display()
             );
         }
+        if let (Some(fc), Some(dut)) = (&fc, &dut) {
+            super::vfc::report(fc, dut, &dir)?;
+        }
         Ok(())
     }
+}
+
+/// The firmware device, bare or with a virtual flight controller on its chip.
+enum Device {
+    Plain(margemu::loopback::LoopbackDevice),
+    Fc(margemu::vfc::VfcRig),
 }

@@ -9,6 +9,7 @@ pub mod ports;
 pub mod scene;
 pub mod simulate;
 pub mod stream;
+mod vfc;
 
 /// Every subcommand.
 #[derive(clap::Subcommand)]

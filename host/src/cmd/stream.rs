@@ -1,11 +1,14 @@
-//! `margemu stream SCENE --port PATH [--baud N] [-o DIR]`: stream a scene to a device in real
-//! time and write the session directory.
+//! `margemu stream SCENE --port PATH [--baud N] [-o DIR] [--dut PORT --dut-protocol P]`: stream a
+//! scene to a device in real time and write the session directory; with `--dut`, log the device
+//! under test's own output beside it.
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use margemu::dut::{open_dut_port, DutConfig, DutProtocol, DutSummary};
 use margemu::scene::Scene;
 use margemu::stream::{open_port, Progress, Session, SourceMode, StreamConfig};
-use std::path::PathBuf;
+use margemu::vfc::{attach, AttachedDut};
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 #[derive(clap::Args)]
@@ -33,6 +36,42 @@ pub struct Cmd {
     mag_ut_per_unit: Option<f64>,
     #[command(flatten)]
     source: SourceArgs,
+    #[command(flatten)]
+    dut: DutArgs,
+}
+
+/// The device under test's own output port.
+#[derive(clap::Args)]
+pub struct DutArgs {
+    /// The device under test's telemetry port (its attitude as MAVLink or MSP), read during the
+    /// session into dut_*.csv on the session's clock.
+    #[arg(long, value_name = "PORT")]
+    dut: Option<String>,
+    /// What the device under test speaks on --dut.
+    #[arg(long, value_enum, default_value_t = DutProtocol::Mavlink, requires = "dut")]
+    dut_protocol: DutProtocol,
+    /// Line rate of --dut (ignored by USB CDC and pseudo-terminals).
+    #[arg(long, default_value_t = 115_200, requires = "dut")]
+    dut_baud: u32,
+}
+
+impl DutArgs {
+    /// Opens --dut and starts its reader on `session`'s clock, in `dir`; `None` without --dut.
+    pub fn attach(&self, session: &mut Session, dir: &Path) -> Result<Option<AttachedDut>> {
+        let Some(path) = &self.dut else {
+            return Ok(None);
+        };
+        let port = open_dut_port(path, self.dut_baud)?;
+        let config = DutConfig::new(self.dut_protocol);
+        Ok(Some(attach(session, port, config, dir)?))
+    }
+}
+
+/// Stops the device-under-test reader, records its summary in the session and prints it.
+pub fn finish_dut(dut: AttachedDut) -> Result<DutSummary> {
+    let summary = dut.finish().context("the device-under-test reader")?;
+    println!("device under test: {summary}");
+    Ok(summary)
 }
 
 /// Where the device's samples come from.
@@ -101,13 +140,12 @@ impl Cmd {
         };
         let port =
             open_port(&self.port, self.baud).with_context(|| format!("opening {}", self.port))?;
-        stream_to(
-            &scene,
-            prepare(&scene, config, &dir)?,
-            &dir,
-            port,
-            &self.port,
-        )?;
+        let mut session = prepare(&scene, config, &dir)?;
+        let dut = self.dut.attach(&mut session, &dir)?;
+        let streamed = stream_to(&scene, session, &dir, port, &self.port);
+        let dut = dut.map(finish_dut).transpose();
+        streamed?;
+        dut?;
         Ok(())
     }
 }

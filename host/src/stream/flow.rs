@@ -25,7 +25,7 @@ pub(super) struct Run<'s, W: Write, P: FnMut(&Progress)> {
     pub(super) encoder: Encoder,
     pub(super) wire: Vec<u8>,
     pub(super) events: Receiver<RxEvent>,
-    /// Host time 0 of the logs: when the session opened the port.
+    /// Host time 0 of the logs: when the session opened the port, unless `Session::set_origin`.
     pub(super) origin: Instant,
     /// When Start was written: scene time 0.
     pub(super) start: Option<Instant>,
@@ -65,7 +65,7 @@ impl<'s, W: Write, P: FnMut(&Progress)> Run<'s, W, P> {
         events: Receiver<RxEvent>,
         progress: P,
     ) -> Self {
-        let origin = Instant::now();
+        let origin = session.origin.unwrap_or_else(Instant::now);
         let total = session.samples.len();
         let go_back = GoBackN::new(session.stream_len());
         let crcs = session.samples.iter().map(|s| CRC32C.checksum(&s.image));

@@ -100,6 +100,8 @@ pub struct Session {
     pub(super) items: Items,
     pub(super) log: Logger,
     pub(super) stop: Arc<AtomicBool>,
+    /// Host time 0 of the logs; `None`: when the run begins.
+    pub(super) origin: Option<Instant>,
 }
 
 impl Session {
@@ -143,6 +145,7 @@ impl Session {
             items,
             log,
             stop: Arc::new(AtomicBool::new(false)),
+            origin: None,
         })
     }
 
@@ -150,6 +153,13 @@ impl Session {
     /// the logs and returns [`StreamError::Interrupted`].
     pub fn stop_flag(&self) -> Arc<AtomicBool> {
         self.stop.clone()
+    }
+
+    /// Makes `origin` host time 0 of the logs (every `host_ns`, `start_host_ns`) instead of the
+    /// moment the run begins, so that another logger (the device under test's reader,
+    /// [`crate::dut`]) can share the session's clock.
+    pub fn set_origin(&mut self, origin: Instant) {
+        self.origin = Some(origin);
     }
 
     /// The predicted output samples, in order (truth and the image the device should serve).

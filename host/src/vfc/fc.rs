@@ -1,0 +1,290 @@
+//! [`VirtualFc`]: the flight controller's main loop, run at every turn of the loopback device's
+//! loop ([`crate::loopback::spawn_device_with_local`]) with the firmware `Device` it sits on.
+//!
+//! 1. While the device is idle there is nothing to do. Once it is configured (the chip of the
+//!    session exists), the board sets the chip up through the driver ([`Board::init`]) and
+//!    checks that the chip now converts samples the way the host predicted its images; a
+//!    mismatch ends the device loop with the reason (the session then fails with it). A new
+//!    Hello (the device back to idle) starts over.
+//! 2. At each turn, the INT pin: when it says data ready, the driver reads the sample (clearing
+//!    INT), [`to_body`] turns it into SI body axes, and the filter takes it with `dt` = the time
+//!    since the previous sample's data-ready edge.
+//! 3. The output: at the configured rate on the device clock, or after every sample, an
+//!    ATTITUDE and an ATTITUDE_QUATERNION (MAVLink 2, [`mavlink_out`]) with `time_boot_ms` =
+//!    the sample's instant; a HEARTBEAT every second. Frames go to the UART queue.
+//!
+//! **Time.** The flight controller's clock is the device's scene clock: a data-ready edge
+//! happens when the device latches a sample, at that sample's scene instant
+//! ([`Device::last_served`](margemu_firmware::link::Device::last_served)), which is what an edge
+//! interrupt would timestamp. The loop polls the pin, so reads come up to one turn (about 1 ms)
+//! after the edge; a sample latched over before it was read is lost to the flight controller,
+//! as on a board that misses an interrupt, and counted in [`FcReport::late`].
+
+use super::axes::to_body;
+use super::board::Board;
+use super::uart::UartTx;
+use super::{OutputRate, VfcConfig};
+use crate::dut::mavlink_out::{attitude, attitude_quaternion, MavlinkWriter};
+use crate::loopback::Firmware;
+use margemu_filters::{AttitudeFilter, Diagnostics, Imu};
+use margemu_protocol::link::DeviceState;
+use margemu_protocol::regmap::image::ImageConfig;
+use mavlink::dialects::common::{
+    MavAutopilot, MavMessage, MavModeFlag, MavState, MavType, HEARTBEAT_DATA,
+};
+use std::collections::BTreeMap;
+use std::ops::ControlFlow;
+use std::sync::{Arc, Mutex};
+
+/// What the flight controller did (shared with the caller while it runs).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FcReport {
+    /// The filter and its parameters.
+    pub filter: String,
+    /// The bus the driver used (`SPI` or `I2C`).
+    pub bus: &'static str,
+    /// What the driver found at set-up (the last set-up, if the device was configured again).
+    pub init: Option<super::board::InitReport>,
+    /// Set-ups done.
+    pub inits: u64,
+    /// Samples read on data ready.
+    pub samples: u64,
+    /// Reads that came more than 1.5 sample periods after the previous one (samples lost to
+    /// the flight controller).
+    pub late: u64,
+    /// Frames queued per MAVLink message name.
+    pub sent: BTreeMap<&'static str, u64>,
+    /// Frames dropped because the UART queue was full.
+    pub dropped: u64,
+    /// The filter's counters.
+    pub diagnostics: Diagnostics,
+    /// Why the flight controller stopped the device loop, if it did.
+    pub error: Option<String>,
+}
+
+impl FcReport {
+    /// Frames queued, all messages.
+    pub fn frames(&self) -> u64 {
+        self.sent.values().sum()
+    }
+}
+
+/// The flight controller: board, filter, output schedule, telemetry.
+pub struct VirtualFc {
+    config: VfcConfig,
+    expected: ImageConfig,
+    board: Option<Board>,
+    filter: Box<dyn AttitudeFilter<f64> + Send>,
+    /// Instant of the previous sample read, ns.
+    last_ns: Option<u64>,
+    /// Index of the next output instant (for [`OutputRate::Hz`]).
+    next_out: u64,
+    next_heartbeat_ns: u64,
+    mavlink: MavlinkWriter,
+    uart: UartTx,
+    report: Arc<Mutex<FcReport>>,
+}
+
+impl VirtualFc {
+    /// A flight controller of `config` that has not seen its chip yet; `expected` is the
+    /// conversion the host predicted images with; frames go to `uart`; `report` is kept up to
+    /// date.
+    pub fn new(
+        config: VfcConfig,
+        expected: ImageConfig,
+        uart: UartTx,
+        report: Arc<Mutex<FcReport>>,
+    ) -> Result<Self, margemu_filters::Error> {
+        let filter = config.filter.build(config.mag_reference)?;
+        {
+            let mut r = report.lock().unwrap_or_else(|e| e.into_inner());
+            r.filter = format!("{} ({})", config.filter.kind(), config.filter.describe());
+            r.bus = super::board::BUS;
+        }
+        Ok(Self {
+            config,
+            expected,
+            board: None,
+            filter,
+            last_ns: None,
+            next_out: 0,
+            next_heartbeat_ns: 0,
+            mavlink: MavlinkWriter::v2(),
+            uart,
+            report,
+        })
+    }
+
+    /// One turn of the main loop (see the module docs); `Break` ends the device loop.
+    pub fn step(&mut self, device: &mut Firmware, _now_ns: u64) -> ControlFlow<String> {
+        let result = self.turn(device);
+        if let Err(why) = &result {
+            self.update(|r| r.error = Some(why.clone()));
+        }
+        match result {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(why) => ControlFlow::Break(format!("virtual flight controller: {why}")),
+        }
+    }
+
+    fn turn(&mut self, device: &mut Firmware) -> Result<(), String> {
+        if device.state() == DeviceState::Idle {
+            self.board = None;
+            return Ok(());
+        }
+        if self.board.is_none() {
+            let board = self.set_up(device)?;
+            self.board = Some(board);
+        }
+        let Some(board) = &mut self.board else {
+            return Ok(());
+        };
+        if !board.data_ready(device.chip()) {
+            return Ok(());
+        }
+        let t_ns = device.last_served().map_or(0, |s| s.time_ns);
+        let m = board
+            .read(device.chip_mut())
+            .map_err(|e| format!("reading the chip: {e}"))?;
+        let body = to_body(m.accel, m.gyro, m.mag, &self.config.mag_alignment);
+        let period_ns = 1e9 / self.config.sample_rate_hz;
+        let dt_ns = match self.last_ns {
+            Some(last) => t_ns.saturating_sub(last) as f64,
+            None => period_ns,
+        };
+        self.last_ns = Some(t_ns);
+        let imu = Imu {
+            gyro: body.gyro,
+            acc: body.acc,
+            mag: body.mag_ut,
+        };
+        self.filter.update(&imu, dt_ns * 1e-9);
+        let late = dt_ns > 1.5 * period_ns;
+        let diagnostics = self.filter.diagnostics();
+        self.update(|r| {
+            r.samples += 1;
+            r.late += u64::from(late);
+            r.diagnostics = diagnostics;
+        });
+        self.output(t_ns, body.gyro);
+        Ok(())
+    }
+
+    /// Sets the device's chip up and checks its conversion against the host's prediction.
+    fn set_up(&mut self, device: &mut Firmware) -> Result<Board, String> {
+        let (board, init) = Board::init(device.chip_mut(), self.config.sample_rate_hz)
+            .map_err(|e| format!("setting the chip up through the mpu9250 driver: {e}"))?;
+        if init.image != self.expected {
+            return Err(format!(
+                "the driver configured the chip as {:?}, but the host computed its images for {:?}",
+                init.image, self.expected
+            ));
+        }
+        self.filter = self
+            .config
+            .filter
+            .build(self.config.mag_reference)
+            .map_err(|e| e.to_string())?;
+        self.last_ns = None;
+        self.next_out = 0;
+        self.next_heartbeat_ns = 0;
+        self.update(|r| {
+            r.init = Some(init);
+            r.inits += 1;
+        });
+        Ok(board)
+    }
+
+    /// Sends what is due at the sample instant `t_ns`.
+    fn output(&mut self, t_ns: u64, body_rate: [f64; 3]) {
+        if t_ns >= self.next_heartbeat_ns {
+            self.next_heartbeat_ns = t_ns + 1_000_000_000;
+            self.send("HEARTBEAT", &heartbeat());
+        }
+        let due = match self.config.output {
+            OutputRate::EverySample => true,
+            OutputRate::Hz(hz) => {
+                let instant = |k: u64| (k as f64 * 1e9 / hz).floor() as u64;
+                let due = t_ns >= instant(self.next_out);
+                while instant(self.next_out) <= t_ns {
+                    self.next_out += 1;
+                }
+                due
+            }
+        };
+        if due {
+            let q = self.filter.quaternion();
+            let ms = u32::try_from(t_ns / 1_000_000).unwrap_or(u32::MAX);
+            self.send("ATTITUDE", &attitude(ms, q, body_rate));
+            self.send(
+                "ATTITUDE_QUATERNION",
+                &attitude_quaternion(ms, q, body_rate),
+            );
+        }
+    }
+
+    fn send(&mut self, name: &'static str, message: &MavMessage) {
+        // MAVLink 2 carries every common message: encoding cannot fail.
+        let Ok(frame) = self.mavlink.encode(message) else {
+            return;
+        };
+        let queued = self.uart.send(frame);
+        let dropped = self.uart.dropped();
+        self.update(|r| {
+            if queued {
+                *r.sent.entry(name).or_default() += 1;
+            }
+            r.dropped = dropped;
+        });
+    }
+
+    fn update(&self, f: impl FnOnce(&mut FcReport)) {
+        f(&mut self.report.lock().unwrap_or_else(|e| e.into_inner()));
+    }
+}
+
+fn heartbeat() -> MavMessage {
+    MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        custom_mode: 0,
+        mavtype: MavType::MAV_TYPE_QUADROTOR,
+        autopilot: MavAutopilot::MAV_AUTOPILOT_GENERIC,
+        base_mode: MavModeFlag::empty(),
+        system_status: MavState::MAV_STATE_ACTIVE,
+        mavlink_version: 3,
+    })
+}
+
+/// `ecf (kp = 0.5, ki = 0) over SPI: WHO_AM_I 0x71, AK8963 0x48; 600 samples (0 late); sent
+/// ATTITUDE 150, …; 0 dropped; filter: 0 skipped updates, 0 skipped accel, 0 skipped mag, 0
+/// rejected`.
+impl std::fmt::Display for FcReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} over {}: ", self.filter, self.bus)?;
+        match &self.init {
+            Some(i) => write!(
+                f,
+                "WHO_AM_I {:#04x}, AK8963 {:#04x}",
+                i.who_am_i, i.ak8963_wia
+            )?,
+            None => f.write_str("chip never set up")?,
+        }
+        let sent: Vec<String> = self.sent.iter().map(|(m, n)| format!("{m} {n}")).collect();
+        let d = &self.diagnostics;
+        write!(
+            f,
+            "; {} samples read ({} late); sent {}; {} dropped; filter: {} skipped updates, {} skipped accel, {} skipped mag, {} rejected",
+            self.samples,
+            self.late,
+            if sent.is_empty() { "nothing".into() } else { sent.join(", ") },
+            self.dropped,
+            d.skipped_updates,
+            d.skipped_accel,
+            d.skipped_mag,
+            d.rejected
+        )?;
+        if let Some(e) = &self.error {
+            write!(f, "; stopped: {e}")?;
+        }
+        Ok(())
+    }
+}

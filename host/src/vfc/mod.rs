@@ -1,0 +1,150 @@
+//! The virtual flight controller: a device under test that reads the emulated chip through the
+//! `mpu9250` driver crate over the virtual bus, runs a reference filter, and sends MAVLink
+//! ATTITUDE and ATTITUDE_QUATERNION over a pseudo-terminal, like a real board would.
+//!
+//! In loopback the firmware's link handler ([`crate::loopback`]) runs in a thread and latches
+//! the host's register images into its chip at their instants. The flight controller
+//! ([`fc::VirtualFc`]) runs in that same thread, at every turn of the device's loop, and sees
+//! the chip only as a board does:
+//!
+//! - [`board`]: the unmodified `mpu9250` crate initialises the chip (reset, WHO_AM_I, ±16 g,
+//!   ±2000 °/s, DLPF, sample-rate divider, the AK8963 through the driver's own path), latches
+//!   INT on data ready, and reads accelerometer, gyroscope and magnetometer in one burst through
+//!   margemu's embedded-hal adapters (SPI; I2C with the `mpu9250-i2c` feature). Every value comes
+//!   from the chip's registers, never from the host's predicted samples;
+//! - [`axes`]: the driver's units to SI, the AK8963's axes to the body frame
+//!   ([`MagAlignment`]);
+//! - [`params`]: the filter (ECF, GDA or EKF of `margemu-filters`, `f64`) with its defaults or
+//!   a parameters file;
+//! - [`uart`]: the MAVLink 2 frames ([`crate::dut::mavlink_out`]) are queued to a thread that
+//!   writes them to one end of a second pseudo-terminal pair;
+//! - [`rig`]: the device with its flight controller on a PTY, the host end of the flight
+//!   controller's UART, a device-under-test reader ([`crate::dut`]) sharing the session's clock
+//!   and directory ([`rig::attach`]), and one whole loopback run ([`rig::run_loopback`]).
+//!
+//! The host must compute its register images for the full scales the driver sets:
+//! [`image_settings`]. The flight controller checks, after set-up, that the chip converts
+//! exactly that way, and stops the device with the reason if not.
+
+pub mod axes;
+pub mod board;
+pub mod fc;
+pub mod params;
+pub mod rig;
+pub mod uart;
+
+pub use axes::MagAlignment;
+pub use fc::{FcReport, VirtualFc};
+pub use params::{FilterKind, FilterParams};
+pub use rig::{attach, run_loopback, spawn, AttachedDut, FcOutcome, VfcError, VfcRig, VfcRun};
+
+use crate::scene::Scene;
+use crate::stream::ImageSettings;
+use std::fmt;
+use std::str::FromStr;
+
+/// How often the flight controller sends its attitude.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OutputRate {
+    /// At this rate on the device clock (instants `floor(k·10⁹/hz)` ns; each output goes with
+    /// the first sample read at or after its instant).
+    Hz(f64),
+    /// After every sample read.
+    EverySample,
+}
+
+impl Default for OutputRate {
+    /// 50 Hz, a typical telemetry rate for ATTITUDE.
+    fn default() -> Self {
+        Self::Hz(50.0)
+    }
+}
+
+impl fmt::Display for OutputRate {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Hz(hz) => write!(f, "{hz} Hz"),
+            Self::EverySample => f.write_str("every sample"),
+        }
+    }
+}
+
+/// `50` (Hz, > 0) or `every`.
+impl FromStr for OutputRate {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "every" {
+            return Ok(Self::EverySample);
+        }
+        match s.parse::<f64>() {
+            Ok(hz) if hz.is_finite() && hz > 0.0 => Ok(Self::Hz(hz)),
+            _ => Err(format!("`{s}`: expected a rate in Hz (> 0) or `every`")),
+        }
+    }
+}
+
+/// What the flight controller runs and sends.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VfcConfig {
+    /// The filter and its parameters.
+    pub filter: FilterParams,
+    /// World-frame magnetic reference the filter uses (only its direction matters).
+    pub mag_reference: [f64; 3],
+    /// Attitude output rate.
+    pub output: OutputRate,
+    /// How the magnetometer's axes map to the body's.
+    pub mag_alignment: MagAlignment,
+    /// The sample rate the board asks of the chip (Hz): the scene's output rate.
+    pub sample_rate_hz: f64,
+}
+
+impl VfcConfig {
+    /// `filter` on `scene`: the scene's field direction and rate, 50 Hz output, the MPU-9250's
+    /// magnetometer alignment.
+    pub fn for_scene(scene: &Scene, filter: FilterParams) -> Self {
+        Self {
+            filter,
+            mag_reference: scene.spec.field.reference,
+            output: OutputRate::default(),
+            mag_alignment: MagAlignment::default(),
+            sample_rate_hz: scene.clock.hz(),
+        }
+    }
+}
+
+/// The image settings for a chip the flight controller sets up: its full scales
+/// ([`board::image_config`]), otherwise those of [`ImageSettings::for_scene`].
+pub fn image_settings(scene: &Scene) -> ImageSettings {
+    ImageSettings {
+        image: board::image_config(),
+        ..ImageSettings::for_scene(scene)
+    }
+}
+
+/// `margemu evaluate` on a session the flight controller wrote: its ATTITUDE_QUATERNION rows
+/// (ATTITUDE carries the same estimates as Euler angles), aligned and scored with the defaults.
+pub fn evaluate_session(
+    dir: &std::path::Path,
+) -> Result<crate::evaluate::Evaluation, crate::evaluate::EvalError> {
+    use crate::evaluate::{evaluate, EvalOptions, Source};
+    let options = EvalOptions {
+        message: Some("ATTITUDE_QUATERNION".into()),
+        ..EvalOptions::default()
+    };
+    evaluate(&Source::Session(dir.to_path_buf()), &options)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_rates_parse() {
+        assert_eq!("every".parse(), Ok(OutputRate::EverySample));
+        assert_eq!("12.5".parse(), Ok(OutputRate::Hz(12.5)));
+        for bad in ["0", "-3", "inf", "fast"] {
+            assert!(bad.parse::<OutputRate>().is_err(), "{bad}");
+        }
+    }
+}
