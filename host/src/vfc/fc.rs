@@ -8,7 +8,10 @@
 //!    Hello (the device back to idle) starts over.
 //! 2. At each turn, the INT pin: when it says data ready, the driver reads the sample (clearing
 //!    INT), [`to_body`] turns it into SI body axes, and the filter takes it with `dt` = the time
-//!    since the previous sample's data-ready edge.
+//!    since the previous sample's data-ready edge. The filter starts with the first sample that
+//!    carries a magnetometer measurement (the AK8963 delivers its first one a period of its own
+//!    after set-up; a start without it would take yaw 0); the samples before are counted as
+//!    warm-up.
 //! 3. The output: at the configured rate on the device clock, or after every sample, an
 //!    ATTITUDE and an ATTITUDE_QUATERNION (MAVLink 2, [`mavlink_out`]) with `time_boot_ms` =
 //!    the sample's instant; a HEARTBEAT every second. Frames go to the UART queue.
@@ -17,8 +20,9 @@
 //! happens when the device latches a sample, at that sample's scene instant
 //! ([`Device::last_served`](margemu_firmware::link::Device::last_served)), which is what an edge
 //! interrupt would timestamp. The loop polls the pin, so reads come up to one turn (about 1 ms)
-//! after the edge; a sample latched over before it was read is lost to the flight controller,
-//! as on a board that misses an interrupt, and counted in [`FcReport::late`].
+//! after the edge; when the host starves the device thread for longer than a sample period, a
+//! sample latched over before it was read is lost to the flight controller, as on a board that
+//! misses an interrupt, and counted in [`FcReport::missed`] (the filter's `dt` spans the gap).
 
 use super::axes::to_body;
 use super::board::Board;
@@ -49,9 +53,11 @@ pub struct FcReport {
     pub inits: u64,
     /// Samples read on data ready.
     pub samples: u64,
-    /// Reads that came more than 1.5 sample periods after the previous one (samples lost to
-    /// the flight controller).
-    pub late: u64,
+    /// Samples read before the first magnetometer measurement (not filtered).
+    pub warmup: u64,
+    /// Samples never read: latched over by the next one before the flight controller saw its
+    /// data-ready (from the gaps between the instants of the samples read).
+    pub missed: u64,
     /// Frames queued per MAVLink message name.
     pub sent: BTreeMap<&'static str, u64>,
     /// Frames dropped because the UART queue was full.
@@ -75,8 +81,10 @@ pub struct VirtualFc {
     expected: ImageConfig,
     board: Option<Board>,
     filter: Box<dyn AttitudeFilter<f64> + Send>,
-    /// Instant of the previous sample read, ns.
+    /// Instant of the previous sample filtered, ns.
     last_ns: Option<u64>,
+    /// Instant of the previous sample read, ns.
+    last_read_ns: Option<u64>,
     /// Index of the next output instant (for [`OutputRate::Hz`]).
     next_out: u64,
     next_heartbeat_ns: u64,
@@ -107,6 +115,7 @@ impl VirtualFc {
             board: None,
             filter,
             last_ns: None,
+            last_read_ns: None,
             next_out: 0,
             next_heartbeat_ns: 0,
             mavlink: MavlinkWriter::v2(),
@@ -148,6 +157,22 @@ impl VirtualFc {
             .map_err(|e| format!("reading the chip: {e}"))?;
         let body = to_body(m.accel, m.gyro, m.mag, &self.config.mag_alignment);
         let period_ns = 1e9 / self.config.sample_rate_hz;
+        // Samples since the previous read (the first instant of the device clock is 0).
+        let gap_ns = match self.last_read_ns {
+            Some(last) => t_ns.saturating_sub(last) as f64,
+            None => t_ns as f64 + period_ns,
+        };
+        self.last_read_ns = Some(t_ns);
+        let missed = ((gap_ns / period_ns).round() as u64).saturating_sub(1);
+        let warmup = self.last_ns.is_none() && body.mag_ut == [0.0; 3];
+        self.update(|r| {
+            r.samples += 1;
+            r.missed += missed;
+            r.warmup += u64::from(warmup);
+        });
+        if warmup {
+            return Ok(());
+        }
         let dt_ns = match self.last_ns {
             Some(last) => t_ns.saturating_sub(last) as f64,
             None => period_ns,
@@ -159,13 +184,8 @@ impl VirtualFc {
             mag: body.mag_ut,
         };
         self.filter.update(&imu, dt_ns * 1e-9);
-        let late = dt_ns > 1.5 * period_ns;
         let diagnostics = self.filter.diagnostics();
-        self.update(|r| {
-            r.samples += 1;
-            r.late += u64::from(late);
-            r.diagnostics = diagnostics;
-        });
+        self.update(|r| r.diagnostics = diagnostics);
         self.output(t_ns, body.gyro);
         Ok(())
     }
@@ -186,6 +206,7 @@ impl VirtualFc {
             .build(self.config.mag_reference)
             .map_err(|e| e.to_string())?;
         self.last_ns = None;
+        self.last_read_ns = None;
         self.next_out = 0;
         self.next_heartbeat_ns = 0;
         self.update(|r| {
@@ -272,9 +293,10 @@ impl std::fmt::Display for FcReport {
         let d = &self.diagnostics;
         write!(
             f,
-            "; {} samples read ({} late); sent {}; {} dropped; filter: {} skipped updates, {} skipped accel, {} skipped mag, {} rejected",
+            "; {} samples read ({} warm-up), {} missed; sent {}; {} dropped; filter: {} skipped updates, {} skipped accel, {} skipped mag, {} rejected",
             self.samples,
-            self.late,
+            self.warmup,
+            self.missed,
             if sent.is_empty() { "nothing".into() } else { sent.join(", ") },
             self.dropped,
             d.skipped_updates,

@@ -1,0 +1,244 @@
+//! The command line: `margemu loopback --vfc` (a virtual flight controller, its MAVLink read back
+//! and scored), and `--dut PORT` on `loopback` and `stream` with a test thread playing the device
+//! under test on a real PTY, writing frames from the `mavlink` crate's encoder.
+
+use margemu::dut::mavlink_out::{attitude_quaternion, MavlinkWriter};
+use serialport::{SerialPort, TTYPort};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+const SCENE: &str = "duration = 2.0\nrate = 200.0\nseed = 3\nmotion = \"kinematic\"\n\
+    [joints.roll]\ntype = \"sine\"\namplitude = 0.3\nfrequency = 0.5\n\
+    [joints.yaw]\ntype = \"sine\"\namplitude = 0.6\nfrequency = 0.3\n\
+    [sensors.gyro]\nnoise_density = [0.002, 0.002, 0.002]\n";
+
+/// A fresh directory with the scene in it.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("margemu-vfc-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("scene.toml"), SCENE).unwrap();
+    dir
+}
+
+fn margemu(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_margemu"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn text(out: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// `(header, rows)` of a CSV file of the session.
+fn csv(dir: &Path, name: &str) -> (String, Vec<String>) {
+    let text = std::fs::read_to_string(dir.join(name)).unwrap();
+    let mut lines = text.lines().map(str::to_owned);
+    (lines.next().unwrap(), lines.collect())
+}
+
+#[test]
+fn loopback_with_a_flight_controller_reads_back_and_scores_its_mavlink() {
+    let dir = scratch("vfc");
+    std::fs::write(dir.join("params.toml"), "[gda]\nbeta = 0.3\n").unwrap();
+    let session = dir.join("session");
+    let out = margemu(&[
+        "loopback",
+        path(&dir.join("scene.toml")),
+        "-o",
+        path(&session),
+        "--vfc",
+        "gda",
+        "--vfc-params",
+        path(&dir.join("params.toml")),
+    ]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    assert!(
+        all.contains("virtual flight controller: gda (beta = 0.3) over "),
+        "{all}"
+    );
+    assert!(
+        all.contains("every frame the flight controller sent was decoded"),
+        "{all}"
+    );
+    assert!(
+        all.contains("400 of 400 predicted images confirmed byte for byte"),
+        "{all}"
+    );
+    assert!(all.contains("geodesic RMS (rad)"), "{all}");
+    for file in [
+        "dut_attitude.csv",
+        "dut_messages.csv",
+        "report.md",
+        "errors.csv",
+    ] {
+        assert!(session.join(file).is_file(), "{file} missing");
+    }
+    // 2 s at 50 Hz: 100 of each message, in dut_attitude.csv and the session's records.
+    let (_, rows) = csv(&session, "dut_attitude.csv");
+    assert_eq!(rows.len(), 200);
+    let (_, events) = csv(&session, "events.csv");
+    let last = events.last().unwrap();
+    assert!(
+        last.contains(
+            ",dut,mavlink: 202 messages (ATTITUDE 100; ATTITUDE_QUATERNION 100; HEARTBEAT 2)"
+        ),
+        "{last}"
+    );
+    let meta: toml::Table = std::fs::read_to_string(session.join("meta.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(
+        meta["dut"]["per_message"]["ATTITUDE_QUATERNION"].as_integer(),
+        Some(100)
+    );
+}
+
+#[test]
+fn a_bad_parameters_file_is_refused_with_its_location() {
+    let dir = scratch("bad-params");
+    std::fs::write(dir.join("params.toml"), "[ekf]\nmag_noise = -0.5\n").unwrap();
+    let out = margemu(&[
+        "loopback",
+        path(&dir.join("scene.toml")),
+        "-o",
+        path(&dir.join("session")),
+        "--vfc",
+        "ekf",
+        "--vfc-params",
+        path(&dir.join("params.toml")),
+    ]);
+    assert!(!out.status.success());
+    let all = text(&out);
+    assert!(all.contains("params.toml:2:13: "), "{all}");
+    assert!(all.contains("not a finite number ≥ 0"), "{all}");
+}
+
+/// Plays a device under test on a PTY pair: once the reader has created `dut_messages.csv` in
+/// `session`, writes `n` ATTITUDE_QUATERNION frames 10 ms apart. Returns the path the reader
+/// opens and the thread (which keeps both ends open until it ends).
+fn dut_board(session: PathBuf, n: u32) -> (String, std::thread::JoinHandle<()>) {
+    let (mut board, reader_end) = TTYPort::pair().unwrap();
+    let name = reader_end.name().unwrap();
+    let thread = std::thread::spawn(move || {
+        let _keep = reader_end;
+        let deadline = Instant::now() + Duration::from_secs(30);
+        while !session.join("dut_messages.csv").exists() && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        let mut fc = MavlinkWriter::v2();
+        for i in 0..n {
+            let frame = fc
+                .encode(&attitude_quaternion(i * 10, [1.0, 0.0, 0.0, 0.0], [0.0; 3]))
+                .unwrap();
+            board.write_all(&frame).unwrap();
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        // Until the session has surely ended.
+        std::thread::sleep(Duration::from_secs(3));
+    });
+    (name, thread)
+}
+
+/// The reader logged the `n` frames of [`dut_board`] and the session recorded its summary.
+fn assert_dut_logged(session: &Path, n: usize, all: &str) {
+    assert!(
+        all.contains(&format!(
+            "device under test: mavlink: {n} messages (ATTITUDE_QUATERNION {n})"
+        )),
+        "{all}"
+    );
+    let (header, rows) = csv(session, "dut_attitude.csv");
+    assert_eq!(header, margemu::dut::log::ATTITUDE_COLUMNS);
+    assert_eq!(rows.len(), n);
+    let times: Vec<i64> = rows
+        .iter()
+        .map(|r| r.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(times.windows(2).all(|w| w[0] <= w[1]), "{times:?}");
+    let (_, events) = csv(session, "events.csv");
+    let start: i64 = events
+        .iter()
+        .find(|e| e.split(',').nth(1) == Some("start"))
+        .and_then(|e| e.split(',').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    // The reader's clock is the session's: the board wrote from before Start to within 2 s of it.
+    assert!(
+        times.iter().all(|&t| t > 0 && t < start + 2_000_000_000),
+        "{times:?} start {start}"
+    );
+    assert!(
+        events
+            .last()
+            .unwrap()
+            .contains(&format!(",dut,mavlink: {n} messages")),
+        "{events:?}"
+    );
+    let meta: toml::Table = std::fs::read_to_string(session.join("meta.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(meta["dut"]["messages"].as_integer(), Some(n as i64));
+    assert_eq!(meta["dut"]["end"].as_str(), Some("stopped"));
+}
+
+#[test]
+fn loopback_logs_a_device_under_test_on_dut() {
+    let dir = scratch("loopback-dut");
+    let session = dir.join("session");
+    let (port, board) = dut_board(session.clone(), 60);
+    let out = margemu(&[
+        "loopback",
+        path(&dir.join("scene.toml")),
+        "-o",
+        path(&session),
+        "--dut",
+        &port,
+        "--dut-protocol",
+        "mavlink",
+    ]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    assert_dut_logged(&session, 60, &all);
+    board.join().unwrap();
+}
+
+#[test]
+fn stream_logs_a_device_under_test_on_dut() {
+    let dir = scratch("stream-dut");
+    let session = dir.join("session");
+    let (device_end, host_end) = TTYPort::pair().unwrap();
+    let device = margemu::loopback::spawn_device(device_end).unwrap();
+    let (port, board) = dut_board(session.clone(), 60);
+    let out = margemu(&[
+        "stream",
+        path(&dir.join("scene.toml")),
+        "--port",
+        &host_end.name().unwrap(),
+        "-o",
+        path(&session),
+        "--dut",
+        &port,
+    ]);
+    device.stop();
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    assert_dut_logged(&session, 60, &all);
+    board.join().unwrap();
+}
