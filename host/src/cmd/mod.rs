@@ -3,6 +3,7 @@
 pub mod analyze;
 pub mod bench;
 pub mod evaluate;
+mod bench_stream;
 pub mod loopback;
 pub mod ports;
 pub mod scene;
