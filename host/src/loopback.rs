@@ -155,11 +155,28 @@ fn turn(device: &mut Firmware, port: &mut TTYPort, now: impl Fn() -> u64) -> std
         if port.bytes_to_read()? == 0 {
             break;
         }
-        let n = port.read(&mut buf)?;
-        device.feed(&buf[..n], now());
+        match port.read(&mut buf) {
+            Ok(n) => device.feed(&buf[..n], now()),
+            Err(e) if crate::stream::rx::is_transient(&e) => break,
+            Err(e) => return Err(e),
+        }
     }
     let mut out = Vec::new();
     device.poll(t, &mut |frame: &[u8]| out.extend_from_slice(frame));
-    port.write_all(&out)?;
+    write_all(port, &out)?;
     Ok(true)
+}
+
+/// Writes all of `bytes`, waiting out the port's timeouts (the host reads slower than the
+/// device writes now and then); fails on any other error (the host closed its end).
+fn write_all(port: &mut TTYPort, mut bytes: &[u8]) -> std::io::Result<()> {
+    while !bytes.is_empty() {
+        match port.write(bytes) {
+            Ok(0) => return Err(std::io::ErrorKind::WriteZero.into()),
+            Ok(n) => bytes = &bytes[n..],
+            Err(e) if crate::stream::rx::is_transient(&e) => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
 }

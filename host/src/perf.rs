@@ -202,7 +202,7 @@ pub fn stream_sweep(
                 ..StreamConfig::default()
             };
             let session_dir = dir.join(format!("{mode}-{rate_hz}"));
-            let (result, _device) = crate::loopback::run(&scene, config, &session_dir)?;
+            let (result, device) = crate::loopback::run(&scene, config, &session_dir)?;
             let summary = result.as_ref().ok();
             rows.push(StreamRow {
                 rate_hz,
@@ -217,7 +217,9 @@ pub fn stream_sweep(
                 efficiency: summary.map_or(0.0, |s| s.link.efficiency()),
                 lead: summary.map_or(Duration::ZERO, |s| s.lead),
                 batch: summary.map_or(0, |s| s.batch),
-                error: result.err().map(|e| e.to_string()),
+                error: result
+                    .err()
+                    .map(|e| format!("{e} (the device loop ended: {})", device.ended)),
             });
         }
     }

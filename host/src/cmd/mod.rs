@@ -2,8 +2,8 @@
 
 pub mod analyze;
 pub mod bench;
-mod bench_stream;
 pub mod evaluate;
+mod bench_stream;
 pub mod loopback;
 pub mod ports;
 pub mod scene;

@@ -40,6 +40,7 @@ mod logger;
 mod meta;
 pub mod model;
 mod pacing;
+mod reports;
 pub mod resend;
 pub mod rx;
 pub mod served;
