@@ -16,6 +16,7 @@
 //! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs;
 //! - [`evaluate`](mod@evaluate): scores of a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned and split by phase.
 //! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged.
+//! - [`demo`]: the case study through loopback with the virtual flight controller (Table 3).
 //! - [`vfc`]: a virtual flight controller on the loopback device (the `mpu9250` driver, a reference filter, MAVLink out).
 #![warn(missing_docs)]
 
@@ -23,6 +24,7 @@ pub mod analysis;
 pub mod bench;
 pub mod bus;
 pub mod csv_column;
+pub mod demo;
 pub mod dut;
 pub mod evaluate;
 pub mod loopback;

@@ -2,8 +2,9 @@
 
 pub mod analyze;
 pub mod bench;
-pub mod evaluate;
 mod bench_stream;
+pub mod demo;
+pub mod evaluate;
 pub mod loopback;
 pub mod ports;
 pub mod scene;
@@ -33,6 +34,8 @@ pub enum Command {
     Ports(ports::Cmd),
     /// Score a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned.
     Evaluate(evaluate::Cmd),
+    /// The paper's case study through loopback with the virtual flight controller: Table 3.
+    Demo(demo::Cmd),
 }
 
 impl Command {
@@ -46,6 +49,7 @@ impl Command {
             Command::Stream(c) => c.run(),
             Command::Ports(c) => c.run(),
             Command::Evaluate(c) => c.run(),
+            Command::Demo(c) => c.run(),
         }
     }
 }

@@ -1,0 +1,133 @@
+//! `margemu demo`: the paper's case study through loopback with the virtual flight controller,
+//! every filter with its initial and tuned parameters, and the Table 3 analogue (library:
+//! `margemu::demo`).
+
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use margemu::demo::{self, table, DemoOptions, Variant};
+use margemu::scene::Scene;
+use margemu::vfc::{FilterKind, FilterParams};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+#[derive(clap::Args)]
+pub struct Cmd {
+    /// The scene (default: the paper's case study).
+    #[arg(long, default_value = "hil-fixtures/scenes/case-study.toml")]
+    scene: PathBuf,
+    /// Output directory: one session per run (`<filter>-<initial|tuned>/`, with report.md and
+    /// figures) and table3.md.
+    #[arg(short, long, default_value = "demo")]
+    output: PathBuf,
+    /// Shorten the scene to this many seconds (each run streams in real time).
+    #[arg(long, value_name = "S")]
+    duration: Option<f64>,
+    /// Tuned parameters (TOML with [ecf], [gda] and [ekf] tables); without it only the initial
+    /// parameters run.
+    #[arg(long, value_name = "FILE")]
+    tuned: Option<PathBuf>,
+    /// The filters to run.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "ecf,gda,ekf")]
+    filters: Vec<FilterKind>,
+    /// Skip the figures.
+    #[arg(long)]
+    no_plots: bool,
+}
+
+/// Tuned parameters from a file: each filter's table must be there.
+fn from_file(
+    path: &Path,
+) -> Result<impl FnMut(&Scene, FilterKind) -> Result<FilterParams, String>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let tables: toml::Table = text
+        .parse()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let path = path.to_path_buf();
+    Ok(move |_: &Scene, kind: FilterKind| {
+        if !tables.contains_key(kind.name()) {
+            return Err(format!("{} has no [{kind}] table", path.display()));
+        }
+        FilterParams::from_toml(&text, &path, kind).map_err(|e| e.to_string())
+    })
+}
+
+impl Cmd {
+    pub fn run(self) -> Result<()> {
+        let mut scene = Scene::load(&self.scene)?;
+        if let Some(seconds) = self.duration {
+            if !(seconds.is_finite() && seconds > 0.0) {
+                bail!("--duration must be > 0 s, not {seconds}");
+            }
+            scene = demo::shorten(&scene, seconds)?;
+        }
+        let mut tuned = self.tuned.as_deref().map(from_file).transpose()?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+            .context("installing the Ctrl-C handler")?;
+        let (over, n, max) = demo::gyro_clipping(&scene)?;
+        let runs_per_filter = if tuned.is_some() { 2 } else { 1 };
+        println!(
+            "demo: {} ({} s at {} Hz) through loopback with the virtual flight controller: {} run(s) in real time",
+            scene.path.display(),
+            scene.spec.duration,
+            scene.clock.hz(),
+            runs_per_filter * self.filters.len()
+        );
+        println!(
+            "the scene's body rate reaches {max:.1} rad/s; the chip's widest gyro range (±2000 °/s = ±34.9 rad/s) clips {over} of {n} samples ({:.2} %)",
+            100.0 * over as f64 / n.max(1) as f64
+        );
+        let options = DemoOptions {
+            scene,
+            out: self.output.clone(),
+            filters: self.filters.clone(),
+            plots: !self.no_plots,
+        };
+        let bar = ProgressBar::new(0);
+        bar.set_style(
+            ProgressStyle::with_template("{msg:12} {bar:30} {pos}/{len}").expect("valid"),
+        );
+        let tuned = tuned.as_mut().map(|f| f as &mut demo::Tuned<'_>);
+        let runs = demo::run(&options, tuned, &stop, |label, p| {
+            bar.set_message(label.to_string());
+            bar.set_length(p.total);
+            bar.set_position(p.sent);
+        });
+        bar.finish_and_clear();
+        let runs = runs?;
+        for r in &runs {
+            println!(
+                "{} {}: {}; served {}/{} byte for byte; the flight controller read {} samples \
+                 ({} warm-up, {} missed); latency {:.2} ms; {}",
+                r.kind,
+                r.variant.name(),
+                r.params.describe(),
+                r.served.0,
+                r.served.1,
+                r.fc.samples,
+                r.fc.warmup,
+                r.fc.missed,
+                r.latency_ns as f64 * 1e-6,
+                r.dir.display()
+            );
+        }
+        println!("\nTable 3 analogue, ours (paper's):");
+        print!("{}", table::render(&runs, false));
+        for variant in [Variant::Initial, Variant::Tuned] {
+            if let Some(line) = table::ordering(&runs, variant) {
+                println!("{line}");
+            }
+        }
+        if runs_per_filter == 1 {
+            println!("tuned parameters: pass --tuned FILE ([ecf], [gda], [ekf] tables)");
+        }
+        let md = self.output.join("table3.md");
+        std::fs::write(&md, table::render(&runs, true))
+            .with_context(|| format!("writing {}", md.display()))?;
+        println!("wrote {}", md.display());
+        Ok(())
+    }
+}

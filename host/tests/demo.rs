@@ -1,0 +1,122 @@
+//! `margemu demo` on the case-study scene shortened to one second: six loopback runs with the
+//! virtual flight controller (three filters, initial and tuned), the Table 3 analogue with the
+//! paper's figures, and each run's report and figures.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+const CASE_STUDY: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../hil-fixtures/scenes/case-study.toml"
+);
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("margemu-demo-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn demo(args: &[&str]) -> (Output, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
+        .arg("demo")
+        .args(["--scene", CASE_STUDY])
+        .args(args)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out, text)
+}
+
+#[test]
+fn the_case_study_demo_prints_table_3_and_writes_each_runs_report() {
+    let dir = scratch("full");
+    // Parameters in the spirit of tuning (faster corrections); the tuner's come later.
+    std::fs::write(
+        dir.join("tuned.toml"),
+        "[ecf]\nkp = 2.0\nki = 0.01\n[gda]\nbeta = 0.4\n[ekf]\naccel_noise = 1.0\nmag_noise = 1.0\n",
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let (out, text) = demo(&[
+        "--duration",
+        "1",
+        "--tuned",
+        dir.join("tuned.toml").to_str().unwrap(),
+        "-o",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("(1 s at 200 Hz)"), "{text}");
+    assert!(text.contains("6 run(s) in real time"), "{text}");
+    for (column, paper_f) in [
+        ("ECF initial", "(0.5237)"),
+        ("ECF tuned", "(0.1471)"),
+        ("GDA initial", "(1.1950)"),
+        ("GDA tuned", "(0.1812)"),
+        ("EKF initial", "(0.2891)"),
+        ("EKF tuned", "(0.1033)"),
+    ] {
+        assert!(text.contains(column), "{column}: {text}");
+        let f_row = text.lines().find(|l| l.starts_with("F (rad²)")).unwrap();
+        assert!(f_row.contains(paper_f), "{paper_f}: {f_row}");
+    }
+    assert!(text.contains("initial by F: "), "{text}");
+    assert!(text.contains("tuned by F: "), "{text}");
+    // Every run served all 200 images as predicted and was scored from the flight controller's
+    // own MAVLink.
+    assert_eq!(
+        text.matches("served 200/200 byte for byte").count(),
+        6,
+        "{text}"
+    );
+    let table = std::fs::read_to_string(out_dir.join("table3.md")).unwrap();
+    assert!(
+        table.starts_with("| | ECF initial | ECF tuned | GDA initial"),
+        "{table}"
+    );
+    assert_eq!(table.lines().count(), 2 + 9);
+    for run in [
+        "ecf-initial",
+        "ecf-tuned",
+        "gda-initial",
+        "gda-tuned",
+        "ekf-initial",
+        "ekf-tuned",
+    ] {
+        for file in [
+            "dut_attitude.csv",
+            "report.md",
+            "errors.csv",
+            "attitude.png",
+            "attitude.svg",
+        ] {
+            assert!(
+                out_dir.join(run).join(file).is_file(),
+                "{run}/{file} missing"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_tuned_file_without_a_filters_table_stops_the_demo_before_streaming() {
+    let dir = scratch("missing-table");
+    std::fs::write(dir.join("tuned.toml"), "[ecf]\nkp = 2.0\n").unwrap();
+    let (out, text) = demo(&[
+        "--duration",
+        "1",
+        "--tuned",
+        dir.join("tuned.toml").to_str().unwrap(),
+        "-o",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(text.contains("the tuned parameters of gda: "), "{text}");
+    assert!(text.contains("tuned.toml has no [gda] table"), "{text}");
+    assert!(!dir.join("out/ecf-initial").exists(), "nothing streamed");
+}
