@@ -17,11 +17,18 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-fn demo(args: &[&str]) -> (Output, String) {
+/// `margemu demo` on the case study shortened to 1 s, with `tuned` as the tuned parameters
+/// file, into `<scratch>/out`: the process's output, its text, and the output directory.
+fn demo(name: &str, tuned: &str) -> (Output, String, PathBuf) {
+    let dir = scratch(name);
+    std::fs::write(dir.join("tuned.toml"), tuned).unwrap();
+    let out_dir = dir.join("out");
     let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
         .arg("demo")
-        .args(["--scene", CASE_STUDY])
-        .args(args)
+        .args(["--scene", CASE_STUDY, "--duration", "1", "--tuned"])
+        .arg(dir.join("tuned.toml"))
+        .arg("-o")
+        .arg(&out_dir)
         .output()
         .unwrap();
     let text = format!(
@@ -29,27 +36,14 @@ fn demo(args: &[&str]) -> (Output, String) {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    (out, text)
+    (out, text, out_dir)
 }
 
 #[test]
 fn the_case_study_demo_prints_table_3_and_writes_each_runs_report() {
-    let dir = scratch("full");
     // Parameters in the spirit of tuning (faster corrections); the tuner's come later.
-    std::fs::write(
-        dir.join("tuned.toml"),
-        "[ecf]\nkp = 2.0\nki = 0.01\n[gda]\nbeta = 0.4\n[ekf]\naccel_noise = 1.0\nmag_noise = 1.0\n",
-    )
-    .unwrap();
-    let out_dir = dir.join("out");
-    let (out, text) = demo(&[
-        "--duration",
-        "1",
-        "--tuned",
-        dir.join("tuned.toml").to_str().unwrap(),
-        "-o",
-        out_dir.to_str().unwrap(),
-    ]);
+    let tuned = "[ecf]\nkp = 2.0\nki = 0.01\n[gda]\nbeta = 0.4\n[ekf]\naccel_noise = 1.0\nmag_noise = 1.0\n";
+    let (out, text, out_dir) = demo("full", tuned);
     assert!(out.status.success(), "{text}");
     assert!(text.contains("(1 s at 200 Hz)"), "{text}");
     assert!(text.contains("6 run(s) in real time"), "{text}");
@@ -105,18 +99,9 @@ fn the_case_study_demo_prints_table_3_and_writes_each_runs_report() {
 
 #[test]
 fn a_tuned_file_without_a_filters_table_stops_the_demo_before_streaming() {
-    let dir = scratch("missing-table");
-    std::fs::write(dir.join("tuned.toml"), "[ecf]\nkp = 2.0\n").unwrap();
-    let (out, text) = demo(&[
-        "--duration",
-        "1",
-        "--tuned",
-        dir.join("tuned.toml").to_str().unwrap(),
-        "-o",
-        dir.join("out").to_str().unwrap(),
-    ]);
+    let (out, text, out_dir) = demo("missing-table", "[ecf]\nkp = 2.0\n");
     assert!(!out.status.success());
     assert!(text.contains("the tuned parameters of gda: "), "{text}");
     assert!(text.contains("tuned.toml has no [gda] table"), "{text}");
-    assert!(!dir.join("out/ecf-initial").exists(), "nothing streamed");
+    assert!(!out_dir.join("ecf-initial").exists(), "nothing streamed");
 }

@@ -59,7 +59,7 @@ pub fn image_config() -> ImageConfig {
 /// latches samples at the scene's instants either way.
 pub fn sample_rate_divisor(rate_hz: f64) -> Option<u8> {
     let n = 1000.0 / rate_hz;
-    (n.is_finite() && n >= 1.0 && n <= 256.0 && n.fract() == 0.0).then(|| (n as u16 - 1) as u8)
+    ((1.0..=256.0).contains(&n) && n.fract() == 0.0).then(|| (n as u16 - 1) as u8)
 }
 
 /// What the driver found while setting the chip up.
