@@ -15,18 +15,21 @@
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
 //! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs;
 //! - [`evaluate`](mod@evaluate): scores of a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned and split by phase.
-//! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged.
+//! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged;
+//! - [`offline`]: the reference filters (`margemu-filters`) run over recorded samples, estimates written;
+//! - [`tune`](mod@tune): a filter's parameters tuned on a scene over several seeds (Nelder–Mead, eq. 27).
 #![warn(missing_docs)]
 
 pub mod analysis;
 pub mod bench;
 pub mod bus;
 pub mod csv_column;
-pub mod evaluate;
 pub mod dut;
+pub mod evaluate;
 pub mod loopback;
 pub mod marg;
 pub mod motion;
+pub mod offline;
 pub mod output;
 pub mod perf;
 pub mod reference;
@@ -34,3 +37,4 @@ pub mod run;
 pub mod scene;
 pub mod stream;
 pub mod truth;
+pub mod tune;

@@ -3,11 +3,13 @@
 pub mod analyze;
 pub mod bench;
 pub mod evaluate;
+pub mod filter;
 pub mod loopback;
 pub mod ports;
 pub mod scene;
 pub mod simulate;
 pub mod stream;
+pub mod tune;
 
 /// Every subcommand.
 #[derive(clap::Subcommand)]
@@ -31,6 +33,10 @@ pub enum Command {
     Ports(ports::Cmd),
     /// Score a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned.
     Evaluate(evaluate::Cmd),
+    /// Run a reference filter (ECF, GDA, EKF) offline over a recording; write its estimates.
+    Filter(filter::Cmd),
+    /// Tune a reference filter's parameters on a scene over several seeds (eq. 27, Table 3).
+    Tune(tune::Cmd),
 }
 
 impl Command {
@@ -44,6 +50,8 @@ impl Command {
             Command::Stream(c) => c.run(),
             Command::Ports(c) => c.run(),
             Command::Evaluate(c) => c.run(),
+            Command::Filter(c) => c.run(),
+            Command::Tune(c) => c.run(),
         }
     }
 }
