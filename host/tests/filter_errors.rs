@@ -3,7 +3,7 @@
 
 mod filter_common;
 
-use filter_common::{failed, margemu, ok, scene_in, scratch, STATIC_SCENE};
+use filter_common::{failed, margemu, ok, scratch, simulated, STATIC_SCENE};
 use margemu::offline;
 use std::path::Path;
 
@@ -58,14 +58,7 @@ fn external_recordings_with_bad_rows_are_refused_at_their_line() {
 #[test]
 fn run_directories_with_bad_files_are_refused_with_their_location() {
     let dir = scratch("filter-errors-run");
-    let (scene, _) = scene_in(&dir, "static.toml", STATIC_SCENE);
-    let run = dir.join("run");
-    ok(&margemu(&[
-        "simulate",
-        scene.to_str().unwrap(),
-        "-o",
-        run.to_str().unwrap(),
-    ]));
+    let (_, run) = simulated(&dir, "static.toml", STATIC_SCENE);
     let marg = run.join("marg.csv");
     let text = std::fs::read_to_string(&marg).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();

@@ -5,29 +5,18 @@
 
 mod filter_common;
 
-use filter_common::{margemu, ok, scene_in, scratch, SMALL_SCENE, STATIC_SCENE};
+use filter_common::{margemu, ok, scratch, simulated, SMALL_SCENE, STATIC_SCENE};
 use margemu::evaluate::input::{read_estimates, read_truth};
 use margemu::evaluate::{evaluate, EvalOptions, LatencySearch, ScoreOptions, Source};
 use margemu::offline::{self, AttitudeStart, FilterKind, FilterParams, Initial};
+use margemu::scene::Scene;
 use margemu::tune::Dataset;
 use margemu_filters::quat::{from_euler_zyx, geodesic_angle, mul};
-use std::path::Path;
-
-fn simulate(scene: &Path, run: &Path) {
-    ok(&margemu(&[
-        "simulate",
-        scene.to_str().unwrap(),
-        "-o",
-        run.to_str().unwrap(),
-    ]));
-}
 
 #[test]
 fn on_a_noise_free_static_run_every_filter_converges_to_the_truth() {
     let dir = scratch("filter-static");
-    let (scene, _) = scene_in(&dir, "static.toml", STATIC_SCENE);
-    let run = dir.join("run");
-    simulate(&scene, &run);
+    let (_, run) = simulated(&dir, "static.toml", STATIC_SCENE);
     let truth = read_truth(&run.join("truth.csv")).unwrap().attitude[0].1;
     let rec = offline::read(&run, None).unwrap();
     assert_eq!(rec.imu.t_ns.len(), 4000);
@@ -76,9 +65,7 @@ fn on_a_noise_free_static_run_every_filter_converges_to_the_truth() {
 #[test]
 fn a_run_directory_and_the_same_samples_as_csv_give_the_same_estimates() {
     let dir = scratch("filter-csv");
-    let (scene, _) = scene_in(&dir, "small.toml", SMALL_SCENE);
-    let run = dir.join("run");
-    simulate(&scene, &run);
+    let (_, run) = simulated(&dir, "small.toml", SMALL_SCENE);
     // The external format: t_s and the nine columns, in another order, with an extra column.
     let marg = std::fs::read_to_string(run.join("marg.csv")).unwrap();
     let mut csv = String::from("t_s,gx,gy,gz,ax,ay,az,mx,my,mz,note\n");
@@ -126,9 +113,8 @@ fn a_run_directory_and_the_same_samples_as_csv_give_the_same_estimates() {
 #[test]
 fn scores_of_a_filtered_run_directory_equal_the_tuners() {
     let dir = scratch("filter-scores");
-    let (scene_path, scene) = scene_in(&dir, "small.toml", SMALL_SCENE);
-    let run = dir.join("run");
-    simulate(&scene_path, &run);
+    let (scene_path, run) = simulated(&dir, "small.toml", SMALL_SCENE);
+    let scene = Scene::load(&scene_path).unwrap();
     let mut params = FilterParams::defaults(FilterKind::Ecf);
     params.set("kp", 1.5).unwrap();
     let estimates = dir.join("ecf.csv");

@@ -4,7 +4,7 @@
 
 mod filter_common;
 
-use filter_common::{failed, margemu, ok, scene_in, scratch, SMALL_SCENE};
+use filter_common::{failed, margemu, ok, scene_in, scratch, simulated, SMALL_SCENE};
 use margemu::offline::{FilterKind, FilterParams};
 use margemu::tune::{tune, tune_dataset, AttitudeStart, Dataset, Objective, TuneOptions};
 
@@ -157,13 +157,7 @@ fn cli_prints_the_table_and_writes_parameters_filter_takes() {
     assert_ne!(gda, FilterParams::defaults(FilterKind::Gda));
     let ecf = FilterParams::from_toml(&text, path, FilterKind::Ecf).unwrap();
     assert_ne!(ecf, FilterParams::defaults(FilterKind::Ecf));
-    let run = dir.join("run");
-    ok(&margemu(&[
-        "simulate",
-        scene.to_str().unwrap(),
-        "-o",
-        run.to_str().unwrap(),
-    ]));
+    let (_, run) = simulated(&dir, "small.toml", SMALL_SCENE);
     let estimates = dir.join("gda.csv");
     let filtered = ok(&margemu(&[
         "filter",

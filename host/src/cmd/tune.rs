@@ -62,8 +62,9 @@ impl Cmd {
             initial_params: None,
         };
         println!(
-            "objective: mean over seeds of {}, warm-up {} s, at most about {} evaluations per filter\n",
-            opts.objective, opts.warmup_s, opts.max_evals
+            "objective: mean over seeds of {}, start {}, warm-up {} s, at most about {} evaluations \
+             per filter\n",
+            opts.objective, opts.attitude_start, opts.warmup_s, opts.max_evals
         );
         for kind in self.filter.iter().copied() {
             self.tune_one(&data, kind, &opts)?;

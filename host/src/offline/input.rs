@@ -174,14 +174,14 @@ struct Row {
 }
 
 fn read_external(path: &Path, mag_reference: [f64; 3]) -> Result<Recording, InputError> {
+    let file = std::fs::File::open(path).map_err(|e| bad(path, format!("cannot read: {e}")))?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(std::io::BufReader::new(file));
     let read_err = |source| ColumnError::Read {
         path: path.to_path_buf(),
         source,
     };
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(read_err)?;
     let header = reader.headers().map_err(read_err)?.clone();
     if let Some(missing) = COLUMNS.iter().find(|c| !header.iter().any(|h| h == **c)) {
         let found = header.iter().collect::<Vec<_>>().join(", ");

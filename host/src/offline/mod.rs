@@ -31,6 +31,7 @@
 
 pub mod input;
 pub mod params;
+mod params_file;
 
 pub use input::{first_true_attitude, read, InputError, Recording};
 pub use margemu_filters::Initial;
@@ -66,6 +67,15 @@ impl std::str::FromStr for AttitudeStart {
             "truth" => Ok(Self::Truth),
             _ => Err(format!("unknown start `{s}` (first-sample or truth)")),
         }
+    }
+}
+
+impl std::fmt::Display for AttitudeStart {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::FirstSample => "first-sample",
+            Self::Truth => "truth",
+        })
     }
 }
 

@@ -87,6 +87,16 @@ pub fn scene_in(dir: &Path, name: &str, text: &str) -> (PathBuf, Scene) {
     (path, scene)
 }
 
+/// `text` as a scene named `name` in `dir`, simulated by `margemu simulate` into `dir/run`:
+/// the scene file and the run directory.
+pub fn simulated(dir: &Path, name: &str, text: &str) -> (PathBuf, PathBuf) {
+    let (scene, _) = scene_in(dir, name, text);
+    let run = dir.join("run");
+    let (s, r) = (scene.to_str().unwrap(), run.to_str().unwrap());
+    ok(&margemu(&["simulate", s, "-o", r]));
+    (scene, run)
+}
+
 /// Runs the `margemu` binary.
 pub fn margemu(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_margemu"))
