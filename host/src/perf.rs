@@ -5,10 +5,16 @@
 //!   below any in the sweep), and the simulated seconds per wall second of dynamics + ground
 //!   truth (no file output).
 //! - [`mode_costs`]: the cost per output sample of a static, a kinematic and a bench scene.
+//! - [`stream_sweep`]: scenes streamed in real time through a PTY pair to the firmware's link
+//!   handler at several rates, in both source modes: samples sent, served byte for byte, lost,
+//!   pacing jitter, link efficiency measured on the batches written;
+//! - [`link_table`]: worst-case link efficiency of image and kinematics batches, and the rates a
+//!   UART carries.
 
 use crate::reference::ReferenceError;
 use crate::run::for_each;
 use crate::scene::{Method, Scene};
+use crate::stream::{JitterStats, ServedStats, SourceMode, StreamConfig};
 use crate::truth::geodesic_angle;
 use margemu_model::time::nanos_from_seconds;
 use std::hint::black_box;
@@ -123,6 +129,141 @@ pub fn mode_costs(scenes: &[Scene], min_wall: Duration) -> Result<Vec<ModeRow>, 
                 ns_per_sample: wall * 1e9 / s.samples() as f64,
                 realtime_factor: s.spec.duration / wall,
             })
+        })
+        .collect()
+}
+
+/// One row of the streaming table: a scene streamed in real time through a PTY pair to the
+/// firmware's link handler ([`crate::loopback`]), checked against the prediction.
+#[derive(Clone, Debug)]
+pub struct StreamRow {
+    /// Output rate, Hz.
+    pub rate_hz: f64,
+    /// The source mode (kinematics rate resolved).
+    pub source: SourceMode,
+    /// Samples in the scene.
+    pub samples: u64,
+    /// Items written (images, or kinematics samples), first copies.
+    pub sent: u64,
+    /// What the device reported serving, against the prediction.
+    pub served: ServedStats,
+    /// How late the batches' writes started (pacing) and completed, against the scene clock.
+    pub jitter: JitterStats,
+    /// How late the same writes completed.
+    pub written_jitter: JitterStats,
+    /// Batches that waited for credit.
+    pub credit_stalls: u64,
+    /// Go-backs.
+    pub resends: u64,
+    /// Measured item bytes per wire byte of the batches written.
+    pub efficiency: f64,
+    /// Lead used, and items per batch.
+    pub lead: Duration,
+    /// Items per batch.
+    pub batch: u64,
+    /// The session's error, if it ended early.
+    pub error: Option<String>,
+}
+
+/// A kinematic scene with noise on every sensor (so consecutive images differ), `seconds` long
+/// at `rate_hz`.
+pub fn stream_scene(rate_hz: f64, seconds: f64) -> Scene {
+    let text = format!(
+        "name = \"bench-stream\"\nduration = {seconds}\nrate = {rate_hz}\nseed = 7\n\
+         motion = \"kinematic\"\n\
+         [joints.roll]\ntype = \"sine\"\namplitude = 0.8\nfrequency = 1.3\n\
+         [joints.yaw]\ntype = \"sine\"\namplitude = 1.5\nfrequency = 0.7\n\
+         [sensors.gyro]\nnoise_density = [0.01, 0.01, 0.01]\n\
+         [sensors.accel]\nnoise_density = [0.02, 0.02, 0.02]\n\
+         [sensors.mag]\nnoise_density = [0.002, 0.002, 0.002]\n"
+    );
+    Scene::parse_str(&text, std::path::Path::new("bench-stream.toml")).expect("a valid scene")
+}
+
+/// Streams [`stream_scene`] at each rate and source through the loopback device, writing each
+/// session's logs under `dir`.
+pub fn stream_sweep(
+    rates: &[f64],
+    sources: &[SourceMode],
+    seconds: f64,
+    dir: &std::path::Path,
+) -> Result<Vec<StreamRow>, crate::stream::StreamError> {
+    let mut rows = Vec::new();
+    for &source in sources {
+        for &rate_hz in rates {
+            let scene = stream_scene(rate_hz, seconds);
+            let mode = match source {
+                SourceMode::Images => "images",
+                SourceMode::Model { .. } => "model",
+            };
+            let config = StreamConfig {
+                port: "pty".into(),
+                source,
+                ..StreamConfig::default()
+            };
+            let session_dir = dir.join(format!("{mode}-{rate_hz}"));
+            let (result, device) = crate::loopback::run(&scene, config, &session_dir)?;
+            let summary = result.as_ref().ok();
+            rows.push(StreamRow {
+                rate_hz,
+                source: summary.map_or(source, |s| s.source),
+                samples: scene.samples(),
+                sent: summary.map_or(0, |s| s.sent),
+                served: summary.map_or_else(ServedStats::default, |s| s.served),
+                jitter: summary.map_or_else(JitterStats::default, |s| s.jitter),
+                written_jitter: summary.map_or_else(JitterStats::default, |s| s.written_jitter),
+                credit_stalls: summary.map_or(0, |s| s.credit_stalls),
+                resends: summary.map_or(0, |s| s.resends),
+                efficiency: summary.map_or(0.0, |s| s.link.efficiency()),
+                lead: summary.map_or(Duration::ZERO, |s| s.lead),
+                batch: summary.map_or(0, |s| s.batch),
+                error: result
+                    .err()
+                    .map(|e| format!("{e} (the device loop ended: {})", device.ended)),
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// One row of the link table: a batch of `items` items of `item_len` bytes.
+#[derive(Clone, Copy, Debug)]
+pub struct LinkRow {
+    /// Items per batch frame.
+    pub items: usize,
+    /// Bytes per item (22 image, 53 kinematics).
+    pub item_len: usize,
+    /// Worst-case wire bytes of the frame.
+    pub wire_bytes: usize,
+}
+
+impl LinkRow {
+    /// Item bytes per wire byte.
+    pub fn efficiency(&self) -> f64 {
+        (self.items * self.item_len) as f64 / self.wire_bytes as f64
+    }
+
+    /// Items per second a UART at `baud` carries (10 line bits per byte: 8N1).
+    pub fn items_per_s(&self, baud: u32) -> f64 {
+        f64::from(baud) / 10.0 / self.wire_bytes as f64 * self.items as f64
+    }
+}
+
+/// Worst-case link efficiency of image batches (1 to 69 images) and kinematics batches (1 to
+/// 28 samples).
+pub fn link_table() -> Vec<LinkRow> {
+    use margemu_protocol::link::{
+        IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
+    };
+    let images = [1, 8, 16, 32, MAX_IMAGES_PER_BATCH].map(|n| (n, IMAGE_LEN));
+    let kinematics = [1, 8, 16, MAX_KINEMATICS_PER_BATCH].map(|n| (n, TRUTH_LEN));
+    images
+        .into_iter()
+        .chain(kinematics)
+        .map(|(items, item_len)| LinkRow {
+            items,
+            item_len,
+            wire_bytes: crate::stream::batch_wire_len(items, item_len),
         })
         .collect()
 }

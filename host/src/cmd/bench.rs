@@ -32,6 +32,10 @@ pub enum Cmd {
         #[arg(long, default_value_t = 1.0)]
         seconds: f64,
     },
+    /// Real-time streaming through a PTY pair to the firmware's link handler: samples served
+    /// byte for byte and lost at each rate, pacing jitter, link efficiency and the rates a UART
+    /// carries.
+    Stream(super::bench_stream::Cmd),
 }
 
 fn builtin(text: &str, name: &str) -> Result<Scene> {
@@ -91,6 +95,7 @@ impl Cmd {
                     );
                 }
             }
+            Cmd::Stream(cmd) => cmd.run()?,
             Cmd::Modes { seconds } => {
                 let scenes = [
                     builtin(STATIC, "static.toml (built in, 200 Hz)")?,

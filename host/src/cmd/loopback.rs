@@ -1,12 +1,11 @@
 //! `margemu loopback SCENE [-o DIR]`: the embedded default. The firmware's link handler runs on
 //! the host behind a real pseudo-terminal pair, the scene streams to it exactly as to a board,
-//! and every image the device served is checked against the host's prediction.
+//! and every image the device reports serving is checked against the host's prediction.
 
-use super::stream::{prepare, stream_to};
+use super::stream::{prepare, stream_to, SourceArgs};
 use anyhow::{bail, Context, Result};
 use margemu::scene::Scene;
 use margemu::stream::{ImageSettings, StreamConfig};
-use margemu_protocol::link::CRC32C;
 use serialport::{SerialPort, TTYPort};
 use std::path::PathBuf;
 
@@ -17,6 +16,8 @@ pub struct Cmd {
     /// Session directory (default: sessions/<scene name>-loopback).
     #[arg(short, long)]
     output: Option<PathBuf>,
+    #[command(flatten)]
+    source: SourceArgs,
 }
 
 impl Cmd {
@@ -35,41 +36,32 @@ impl Cmd {
         let config = StreamConfig {
             port: label.clone(),
             images: Some(settings),
+            source: self.source.mode()?,
             ..StreamConfig::default()
         };
         let session = prepare(&scene, config, &dir)?;
-        let expected: Vec<u32> = session
-            .samples()
-            .iter()
-            .map(|s| CRC32C.checksum(&s.image))
-            .collect();
         let streamed = stream_to(&scene, session, &dir, host_end, &label);
         let report = device.stop();
-        streamed?;
-        let mut matched = 0usize;
-        for &(index, crc, underrun) in &report.served {
-            let Some(&predicted) = expected.get(index as usize) else {
-                continue;
-            };
-            if underrun || crc != predicted {
-                bail!(
-                    "the device served sample {index} differently from the prediction ({}); logs in {}",
-                    if underrun { "an underrun" } else { "CRC mismatch" },
-                    dir.display()
-                );
-            }
-            matched += 1;
-        }
-        let (served, underruns, overruns) = report.counters;
+        let summary = streamed?;
+        let s = summary.served;
+        let overruns = summary.telemetry.map_or(0, |t| t.overruns);
         println!(
-            "loopback: the device served {served} samples ({underruns} underruns, {overruns} overruns); \
-             {matched} of {} predicted images confirmed byte for byte",
-            expected.len()
+            "loopback: the device served {} samples ({} underruns, {overruns} overruns); \
+             {} of {} predicted images confirmed byte for byte ({} mismatched, {} not reported); device {}",
+            s.reported, s.underruns, s.byte_exact, s.samples, s.mismatched, s.unreported, report.ended
         );
-        if matched != expected.len() {
+        if let Some(k) = s.first_mismatch {
             bail!(
-                "only {matched} of {} images were confirmed as served",
-                expected.len()
+                "the device served sample {k} differently from the prediction; logs in {}",
+                dir.display()
+            );
+        }
+        if s.lost() > 0 {
+            bail!(
+                "only {} of {} images were confirmed as served; logs in {}",
+                s.byte_exact,
+                s.samples,
+                dir.display()
             );
         }
         Ok(())

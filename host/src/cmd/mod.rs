@@ -3,6 +3,7 @@
 pub mod analyze;
 pub mod bench;
 pub mod evaluate;
+mod bench_stream;
 pub mod filter;
 pub mod loopback;
 pub mod ports;

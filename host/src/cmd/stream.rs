@@ -4,7 +4,7 @@
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use margemu::scene::Scene;
-use margemu::stream::{open_port, Progress, Session, StreamConfig};
+use margemu::stream::{open_port, Progress, Session, SourceMode, StreamConfig};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -21,8 +21,9 @@ pub struct Cmd {
     /// Session directory (default: sessions/<scene name>).
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Write each batch this many milliseconds before its first sample's instant.
-    #[arg(long, default_value_t = 20.0)]
+    /// Write each batch this many milliseconds before its first sample's instant (at most 3/8
+    /// of the device's buffer).
+    #[arg(long, default_value_t = 200.0)]
     lead_ms: f64,
     /// Most register images per batch.
     #[arg(long, default_value_t = 32)]
@@ -30,6 +31,45 @@ pub struct Cmd {
     /// µT per unit of the scene's field (default: 1 for µT scenes, 50 for normalized ones).
     #[arg(long)]
     mag_ut_per_unit: Option<f64>,
+    #[command(flatten)]
+    source: SourceArgs,
+}
+
+/// Where the device's samples come from.
+#[derive(clap::Args)]
+pub struct SourceArgs {
+    /// `images`: the host sends every register image; `model`: the host sends true kinematics
+    /// and the device runs the shared sensor model (scenes without a perturbation).
+    #[arg(long, value_enum, default_value_t = Source::Images)]
+    source: Source,
+    /// Kinematics rate for `--source model`, Hz: the output rate divided by a whole number
+    /// (default: the output rate / max(2, ceil(rate / 1000 Hz))).
+    #[arg(long, value_name = "HZ")]
+    kinematics_rate: Option<f64>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Source {
+    Images,
+    Model,
+}
+
+impl SourceArgs {
+    /// The library's source mode; a kinematics rate without `--source model` is an error.
+    pub fn mode(&self) -> Result<SourceMode> {
+        match self.source {
+            Source::Images => {
+                anyhow::ensure!(
+                    self.kinematics_rate.is_none(),
+                    "--kinematics-rate needs --source model"
+                );
+                Ok(SourceMode::Images)
+            }
+            Source::Model => Ok(SourceMode::Model {
+                kinematics_hz: self.kinematics_rate,
+            }),
+        }
+    }
 }
 
 impl Cmd {
@@ -48,12 +88,15 @@ impl Cmd {
             self.lead_ms.is_finite() && self.lead_ms >= 0.0,
             "--lead-ms must be ≥ 0"
         );
+        let batch = self.batch.max(1);
         let config = StreamConfig {
             port: self.port.clone(),
             baud: self.baud,
             images: Some(images),
+            source: self.source.mode()?,
             lead: Duration::from_secs_f64(self.lead_ms / 1000.0),
-            batch: self.batch.max(1),
+            batch,
+            resend_after: resend_after(batch, self.baud),
             ..StreamConfig::default()
         };
         let port =
@@ -67,6 +110,21 @@ impl Cmd {
         )?;
         Ok(())
     }
+}
+
+/// A batch counts as lost 20 ms plus two line times of the largest batch after its write (the
+/// batch before it may still be on the line).
+fn resend_after(batch: usize, baud: u32) -> Duration {
+    use margemu::stream::batch_wire_len;
+    use margemu_protocol::link::{
+        IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
+    };
+    let bytes = batch_wire_len(batch.min(MAX_IMAGES_PER_BATCH), IMAGE_LEN).max(batch_wire_len(
+        batch.min(MAX_KINEMATICS_PER_BATCH),
+        TRUTH_LEN,
+    ));
+    let line = Duration::from_secs_f64(10.0 * bytes as f64 / f64::from(baud.max(1)));
+    Duration::from_millis(20) + 2 * line
 }
 
 /// Prepares the session of `scene` in `dir` (every image predicted).
@@ -88,7 +146,7 @@ pub fn stream_to(
     let stop = session.stop_flag();
     ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
         .context("installing the Ctrl-C handler")?;
-    let bar = ProgressBar::new(scene.samples());
+    let bar = ProgressBar::new(session.samples().len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),
     );
@@ -106,9 +164,13 @@ pub fn stream_to(
     let summary = summary?;
     let t = summary.telemetry;
     println!(
-        "sent {}/{} samples in {:.2} s to {}; served {}, underruns {}, overruns {}, device CRC errors {}, host receive errors {}",
+        "sent {}/{} {} in {:.2} s to {}; served {}, underruns {}, overruns {}, device CRC errors {}, host receive errors {}",
         summary.sent,
-        summary.samples,
+        summary.stream_len,
+        match summary.source {
+            SourceMode::Images => "images",
+            SourceMode::Model { .. } => "kinematics samples",
+        },
         summary.elapsed.as_secs_f64(),
         label,
         t.map_or(0, |t| t.samples_served),
@@ -116,6 +178,11 @@ pub fn stream_to(
         t.map_or(0, |t| t.overruns),
         t.map_or(0, |t| t.crc_errors),
         summary.host_rx.crc_errors + summary.host_rx.framing_errors,
+    );
+    let s = summary.served;
+    println!(
+        "served as predicted, byte for byte: {} of {} samples ({} underruns, {} mismatched, {} not reported; served.csv)",
+        s.byte_exact, s.samples, s.underruns, s.mismatched, s.unreported
     );
     let j = summary.jitter;
     println!(
@@ -130,6 +197,7 @@ pub fn stream_to(
 }
 
 fn show(bar: &ProgressBar, p: &Progress) {
+    bar.set_length(p.total);
     bar.set_position(p.sent);
     let secs = p.elapsed.as_secs_f64();
     let t = p.telemetry;
@@ -140,7 +208,9 @@ fn show(bar: &ProgressBar, p: &Progress) {
         0.0
     };
     bar.set_message(format!(
-        "| {rate:.0} samples/s served | underruns {} | CRC errors dev {} host {} | jitter {:.0} µs (max {:.0})",
+        "| {rate:.0} samples/s served | {} byte-exact, {} mismatched | underruns {} | CRC errors dev {} host {} | jitter {:.0} µs (max {:.0})",
+        p.served.byte_exact,
+        p.served.mismatched,
         t.map_or(0, |t| t.underruns),
         t.map_or(0, |t| t.crc_errors),
         p.host_rx.crc_errors,

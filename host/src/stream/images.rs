@@ -33,8 +33,7 @@ pub const DEFAULT_UT_PER_NU: f64 = 50.0;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageSettings {
     /// Full scales, magnetometer resolution, fuse ROM ASA and offsets assumed for the chip.
-    /// The chip's power-on defaults ([`ImageConfig::NOMINAL`]: ±2 g, ±250 °/s, 14-bit, ASA 128)
-    /// unless the caller says otherwise.
+    /// The emulated chip's power-on state ([`chip_power_on`]) unless the caller says otherwise.
     pub image: ImageConfig,
     /// µT per unit of the scene's magnetic field.
     pub mag_ut_per_unit: f64,
@@ -43,11 +42,11 @@ pub struct ImageSettings {
 }
 
 impl ImageSettings {
-    /// The chip's power-on settings; 1 µT per unit for µT scenes, [`DEFAULT_UT_PER_NU`] for
+    /// The emulated chip's power-on settings ([`chip_power_on`]); 1 µT per unit for µT scenes, [`DEFAULT_UT_PER_NU`] for
     /// normalized ones; 25 °C.
     pub fn for_scene(scene: &Scene) -> Self {
         Self {
-            image: ImageConfig::NOMINAL,
+            image: chip_power_on(),
             mag_ut_per_unit: match scene.spec.field.unit {
                 FieldUnit::Microtesla => 1.0,
                 FieldUnit::Normalized => DEFAULT_UT_PER_NU,
@@ -55,6 +54,13 @@ impl ImageSettings {
             default_temp_c: 25.0,
         }
     }
+}
+
+/// The conversion of the emulated chip at power-on, as the firmware's chip reports it: ±2 g,
+/// ±250 °/s, AK8963 14-bit, the AK8963's fuse ROM sensitivity adjustment (ASA, so a driver that
+/// applies it reads the true field), no offsets.
+pub fn chip_power_on() -> ImageConfig {
+    margemu_firmware::chip::Mpu9250::new().image_config()
 }
 
 /// One output sample: its truth and the register image the device should serve for it.

@@ -1,6 +1,7 @@
-//! The session directory: one folder per run, CSV files with a header row, flushed after every
-//! batch and every device message, so an interrupted run (Ctrl-C, a vanished device) leaves every
-//! row written so far readable.
+//! The session directory: one folder per run, CSV files with a header row. During a session the
+//! files are written by their own thread (`Logger`), flushed whenever it has written what was
+//! queued (after every batch and every device message, unless the disk is slower), so an
+//! interrupted run (Ctrl-C, a vanished device) leaves every row so far readable.
 //!
 //! Host times (`host_ns`, `send_ns`) are nanoseconds on the host's monotonic clock since the
 //! session opened the port; `meta.toml`'s `start_host_ns` says when Start was sent, which is scene
@@ -9,23 +10,30 @@
 //! | file | columns |
 //! |---|---|
 //! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample of the scene |
-//! | `sent.csv` | `index,t_ns,send_ns,late_ns,image`: sample index, its latch instant, when its batch was written to the port, how late that write was against its schedule `start_host_ns + t_ns − lead` for the batch's first sample (empty for the prefill, written before Start), and the 22-byte register image as 44 lowercase hex digits |
+//! | `sent.csv` | one row per item written, in the order written. Source images: `index,t_ns,send_ns,late_ns,image,resend`: sample index, its latch instant, when the write of its batch to the port completed, how late that was against the batch's schedule `start_host_ns + t_ns − lead` of its first sample (empty for the prefill, written before Start, and for resends), the 22-byte register image as 44 lowercase hex digits, and `1` if the item was written again because the device had not received it (go-back-N; `0` for the first copy). Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend`: the kinematics sample's index and instant at the kinematics rate, the same times, the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip, and the resend flag |
+//! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before`: each write of the device under test (`bus` spi, i2c or aux; `dropped_before`: writes the device lost just before this batch) |
-//! | `events.csv` | `host_ns,event,detail`: handshake, credit stalls, device errors and resets, host receive errors, and how the session ended |
+//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`) |
 
 use crate::output::TruthWriter;
 use crate::truth::Truth;
-use margemu_protocol::link::{Bus, Image, RegisterWrite, Telemetry};
+use margemu_model::sensor;
+use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use super::images::image_hex;
 
-/// Header of `sent.csv`.
-pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image";
+/// Header of `sent.csv` in source mode images.
+pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image,resend";
+/// Header of `sent.csv` in source mode model.
+pub const SENT_KINEMATICS_COLUMNS: &str =
+    "index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend";
+/// Header of `served.csv`.
+pub const SERVED_COLUMNS: &str = "host_ns,index,time_ns,crc32c,underrun,empty,match";
 /// Header of `device.csv`.
 pub const DEVICE_COLUMNS: &str =
     "host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns";
@@ -40,7 +48,9 @@ pub const EVENTS_COLUMNS: &str = "host_ns,event,detail";
 /// The open CSV files of one session.
 pub struct SessionLog {
     dir: PathBuf,
+    float: ryu::Buffer,
     sent: BufWriter<File>,
+    served: BufWriter<File>,
     device: BufWriter<File>,
     telemetry: BufWriter<File>,
     register_writes: BufWriter<File>,
@@ -54,13 +64,16 @@ fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
 }
 
 impl SessionLog {
-    /// Creates `dir` and every file but `truth.csv`, with their headers, and writes `meta.toml`.
-    pub fn create(dir: &Path, meta: &str) -> io::Result<Self> {
+    /// Creates `dir` and every file but `truth.csv`, with their headers (`sent_columns`: the
+    /// source mode's), and writes `meta.toml`.
+    pub fn create(dir: &Path, meta: &str, sent_columns: &str) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
         std::fs::write(dir.join("meta.toml"), meta)?;
         let mut log = Self {
             dir: dir.to_path_buf(),
-            sent: create(dir, "sent.csv", SENT_COLUMNS)?,
+            float: ryu::Buffer::new(),
+            sent: create(dir, "sent.csv", sent_columns)?,
+            served: create(dir, "served.csv", SERVED_COLUMNS)?,
             device: create(dir, "device.csv", DEVICE_COLUMNS)?,
             telemetry: create(dir, "telemetry.csv", TELEMETRY_COLUMNS)?,
             register_writes: create(dir, "register_writes.csv", REGISTER_WRITES_COLUMNS)?,
@@ -75,6 +88,14 @@ impl SessionLog {
         &self.dir
     }
 
+    /// Appends `text` to `meta.toml`.
+    pub fn append_meta(&mut self, text: &str) -> io::Result<()> {
+        let mut meta = std::fs::OpenOptions::new()
+            .append(true)
+            .open(self.dir.join("meta.toml"))?;
+        meta.write_all(text.as_bytes())
+    }
+
     /// Writes `truth.csv` in one go.
     pub fn write_truth<'a>(&self, truths: impl Iterator<Item = &'a Truth>) -> io::Result<()> {
         let file = BufWriter::with_capacity(1 << 20, File::create(self.dir.join("truth.csv"))?);
@@ -85,20 +106,74 @@ impl SessionLog {
         out.finish()?.flush()
     }
 
-    /// One row of `sent.csv`.
-    pub fn sent(
+    /// One row of `sent.csv` in source mode images.
+    pub fn sent_image(
         &mut self,
         index: u64,
         t_ns: u64,
         send_ns: i64,
         late_ns: Option<i64>,
         image: &Image,
+        resend: bool,
+    ) -> io::Result<()> {
+        self.sent_times(index, t_ns, send_ns, late_ns)?;
+        writeln!(self.sent, ",{},{}", image_hex(image), u8::from(resend))
+    }
+
+    /// One row of `sent.csv` in source mode model.
+    pub fn sent_kinematics(
+        &mut self,
+        index: u64,
+        t_ns: u64,
+        send_ns: i64,
+        late_ns: Option<i64>,
+        k: &sensor::Truth,
+        resend: bool,
+    ) -> io::Result<()> {
+        self.sent_times(index, t_ns, send_ns, late_ns)?;
+        let values = k
+            .angular_rate
+            .iter()
+            .chain(&k.specific_force)
+            .chain(&k.magnetic_field)
+            .chain(&k.angular_acceleration)
+            .chain(&k.temperature_c);
+        for v in values {
+            write!(self.sent, ",{}", self.float.format(*v))?;
+        }
+        if k.temperature_c.is_none() {
+            self.sent.write_all(b",")?;
+        }
+        writeln!(self.sent, ",{}", u8::from(resend))
+    }
+
+    fn sent_times(
+        &mut self,
+        index: u64,
+        t_ns: u64,
+        send_ns: i64,
+        late_ns: Option<i64>,
     ) -> io::Result<()> {
         let late = late_ns.map_or(String::new(), |v| v.to_string());
+        write!(self.sent, "{index},{t_ns},{send_ns},{late}")
+    }
+
+    /// One row of `served.csv`; `matches` is `None` after the scene's last sample.
+    pub fn served(
+        &mut self,
+        host_ns: i64,
+        index: u64,
+        time_ns: u64,
+        entry: &ServedSample,
+        matches: Option<bool>,
+    ) -> io::Result<()> {
+        let matches = matches.map_or("", |m| if m { "1" } else { "0" });
         writeln!(
-            self.sent,
-            "{index},{t_ns},{send_ns},{late},{}",
-            image_hex(image)
+            self.served,
+            "{host_ns},{index},{time_ns},{:08x},{},{},{matches}",
+            entry.crc32c,
+            u8::from(entry.underrun),
+            u8::from(entry.empty)
         )
     }
 
@@ -178,6 +253,7 @@ impl SessionLog {
     /// Flushes every file to the operating system.
     pub fn flush(&mut self) -> io::Result<()> {
         self.sent.flush()?;
+        self.served.flush()?;
         self.device.flush()?;
         self.telemetry.flush()?;
         self.register_writes.flush()?;

@@ -24,6 +24,8 @@ struct Meta<'a> {
     baud: u32,
     who_am_i: u8,
     source: &'a str,
+    kinematics_hold: Option<u32>,
+    kinematics_rate_hz: Option<f64>,
     lead_ns: u64,
     batch: usize,
     telemetry_period_ns: u64,
@@ -45,7 +47,14 @@ struct ImageMeta {
     accel_offset: [i16; 3],
 }
 
-pub(super) fn metadata(scene: &Scene, c: &StreamConfig, s: &ImageSettings, rate: Rate) -> String {
+/// `meta.toml`; `hold` is the kinematics hold of source mode model (`None`: images).
+pub(super) fn metadata(
+    scene: &Scene,
+    c: &StreamConfig,
+    s: &ImageSettings,
+    rate: Rate,
+    hold: Option<u32>,
+) -> String {
     let i = &s.image;
     let meta = Meta {
         margemu_version: env!("CARGO_PKG_VERSION"),
@@ -61,7 +70,9 @@ pub(super) fn metadata(scene: &Scene, c: &StreamConfig, s: &ImageSettings, rate:
         port: &c.port,
         baud: c.baud,
         who_am_i: WHO_AM_I,
-        source: "images",
+        source: if hold.is_some() { "model" } else { "images" },
+        kinematics_hold: hold,
+        kinematics_rate_hz: hold.map(|h| rate.as_hz_f64() / f64::from(h)),
         lead_ns: c.lead.as_nanos() as u64,
         batch: c.batch,
         telemetry_period_ns: c.telemetry_period.as_nanos() as u64,

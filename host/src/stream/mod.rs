@@ -1,38 +1,56 @@
-//! Real-time streaming of a scene to a device over a serial port (issue 5, source mode (a):
-//! register images).
+//! Real-time streaming of a scene to a device over a serial port (issue 5), in either source
+//! mode of `docs/spec/link.md`: (a) register images, (b) true kinematics for the device's own
+//! sensor model.
 //!
-//! A [`Session`] predicts every register image of a validated [`Scene`](crate::scene::Scene)
-//! ([`predict`]: truth → [`MargSim`](crate::marg::MargSim) → [`ImageRepr::from_physical`] with an
-//! explicit [`ImageSettings`]), then speaks the link protocol of `docs/spec/link.md` over any
-//! byte port:
+//! A [`Session`] first predicts every register image the device will serve for a validated
+//! [`Scene`](crate::scene::Scene): in mode (a) [`predict`] (truth →
+//! [`MargSim`](crate::marg::MargSim) → [`ImageRepr::from_physical`] with an explicit
+//! [`ImageSettings`]), in mode (b) [`predict_model`] (the firmware's zero-order hold of the
+//! kinematics and model steps, see [`model`]; scenes the device cannot run are refused here,
+//! before anything is sent). Then it speaks the link protocol over any byte port:
 //!
 //! 1. Hello → HelloAck: the protocol version must match, and the device must emulate the
-//!    MPU-9250 and take register images;
-//! 2. Configure (WHO_AM_I 0x71, the scene's exact rate, source "images") → the first Credit;
-//! 3. prefill (the samples due within the lead, as far as the window allows), then Start
+//!    MPU-9250 and support the source mode;
+//! 2. Configure (WHO_AM_I 0x71, the scene's exact rate, the source and, in mode (b), the model
+//!    parameters) → the first Credit;
+//! 3. prefill (the items due within the lead, as far as the window allows), then Start
 //!    (`t0_ns` = 0), which sets scene time 0 on the host's monotonic clock;
-//! 4. batches paced in real time: the batch that starts at sample `k` is written at
-//!    `start + t_k − lead`, never beyond the device's credit window; the time of every write and
-//!    how late it was against that schedule are logged (pacing jitter);
-//! 5. after the last sample's instant: wait for Telemetry saying it was served, Stop, and wait for
-//!    Telemetry in the stopped state.
+//! 4. batches paced in real time (`pacing.rs`): the batch that starts at
+//!    item `j` is written at `start + t_j − lead`, never beyond the device's credit window; the
+//!    time of every write and how late it was are logged (pacing jitter). Items the device
+//!    reports missing long after they were written are written again ([`resend`]);
+//! 5. Stop after the last sample (in mode (b) once the device reports serving it), then wait
+//!    for Telemetry in the stopped state.
 //!
-//! A receive thread ([`rx`]) decodes Credit, Telemetry, RegisterWrites, Reset and Error frames
-//! concurrently and counts damaged frames. The session stops with a [`StreamError`] on a device
+//! A receive thread ([`rx`]) decodes the device's frames concurrently and counts damaged ones.
+//! Every sample instant the device reports serving (its Served messages: index, CRC-32C of the
+//! image latched) is logged in `served.csv` and checked against the prediction ([`served`]); the
+//! [`Summary`] carries the counts. The session stops with a [`StreamError`] on a device
 //! Reset after the handshake, a fatal device Error, end of file or an error on the port, a
 //! timeout waiting for HelloAck or credit, or the stop flag (Ctrl-C); in every case the logs
-//! ([`log`]) are flushed and end with an `end` row in `events.csv`.
+//! ([`log`], written by their own thread) are flushed and end with an `end` row in
+//! `events.csv`.
 //!
 //! [`ImageRepr::from_physical`]: margemu_protocol::regmap::image::ImageRepr::from_physical
 
+mod flow;
 pub mod images;
 pub mod log;
+mod logger;
 mod meta;
+pub mod model;
+mod pacing;
+mod reports;
+pub mod resend;
 pub mod rx;
+pub mod served;
 mod session;
+mod source;
 
 pub use images::{image_hex, parse_image_hex, predict, ImageSettings, PredictedSample};
-pub use session::{rate_of, Session, StreamConfig, WHO_AM_I};
+pub use model::{kinematics_hold, model_images, predict_model, ModelPrediction};
+pub use served::{ServedCheck, ServedStats};
+pub use session::{rate_of, Session, SourceMode, StreamConfig, WHO_AM_I};
 
 use margemu_protocol::link::{HelloAck, RxStats, Telemetry};
 use std::path::PathBuf;
@@ -101,6 +119,20 @@ pub enum StreamError {
         /// What the port said.
         detail: String,
     },
+    /// source mode model cannot run this scene: {reason}
+    Model {
+        /// Why.
+        reason: String,
+    },
+    /// the kinematics rate {hz} Hz does not divide the output rate {out_hz} Hz: the device holds each kinematics sample for a whole number of output samples (e.g. {hint})
+    KinematicsRate {
+        /// The rate asked for.
+        hz: f64,
+        /// The scene's output rate.
+        out_hz: f64,
+        /// Rates that would do.
+        hint: String,
+    },
     /// interrupted; the device was asked to stop and the logs are complete up to here
     Interrupted,
 }
@@ -108,10 +140,12 @@ pub enum StreamError {
 /// What a running session reports to its progress callback.
 #[derive(Clone, Copy, Debug)]
 pub struct Progress {
-    /// Samples written to the port.
+    /// Items written to the port (images, or kinematics samples in source mode model).
     pub sent: u64,
-    /// Samples in the scene.
+    /// Items in the stream.
     pub total: u64,
+    /// Go-backs so far (items the device had not received, written again).
+    pub resends: u64,
     /// Time since Start.
     pub elapsed: Duration,
     /// The device's latest Telemetry (served samples, underruns, its receive errors).
@@ -122,10 +156,13 @@ pub struct Progress {
     pub last_late_ns: i64,
     /// The latest batch so far, ns.
     pub max_late_ns: i64,
+    /// What the device reported serving so far, against the prediction.
+    pub served: ServedStats,
 }
 
-/// Pacing jitter: how late each batch was written against its schedule, over the batches
-/// written after Start that did not wait for credit (those count as credit stalls).
+/// Pacing jitter: how late batches were written against their schedule, over the batches
+/// written after Start that did not wait for credit (those count as credit stalls) and were
+/// not resends.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct JitterStats {
     /// Batches measured.
@@ -159,19 +196,58 @@ impl JitterStats {
     }
 }
 
+/// What the host wrote to the port.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LinkStats {
+    /// Every byte written (all frames, delimiters included).
+    pub wire_bytes: u64,
+    /// Sample batch frames written.
+    pub batch_frames: u64,
+    /// Their bytes on the wire.
+    pub batch_wire_bytes: u64,
+    /// The item bytes they carried (22 per image, 53 per kinematics sample).
+    pub item_bytes: u64,
+}
+
+impl LinkStats {
+    /// Item bytes per wire byte of the sample batches (link efficiency, before UART framing).
+    pub fn efficiency(&self) -> f64 {
+        self.item_bytes as f64 / self.batch_wire_bytes.max(1) as f64
+    }
+}
+
 /// How a completed session went.
 #[derive(Clone, Debug)]
 pub struct Summary {
     /// Samples in the scene.
     pub samples: u64,
-    /// Samples written to the port.
+    /// Items written to the port (images, or kinematics samples in source mode model), the
+    /// first copy of each.
     pub sent: u64,
+    /// Go-backs: times the device reported an item missing that was written long enough
+    /// before, and the session wrote it and the items after it again.
+    pub resends: u64,
+    /// Items written more than once.
+    pub resent: u64,
+    /// Items in the stream.
+    pub stream_len: u64,
+    /// The source mode (kinematics rate resolved).
+    pub source: SourceMode,
+    /// Items per batch.
+    pub batch: u64,
+    /// How far ahead of their instants batches were written.
+    pub lead: Duration,
+    /// Bytes written.
+    pub link: LinkStats,
     /// The session directory.
     pub dir: PathBuf,
     /// When Start was written, ns since the port was opened (scene time 0).
     pub start_host_ns: Option<i64>,
-    /// Pacing jitter.
+    /// Pacing jitter: how late each paced batch's write started against the scene clock.
     pub jitter: JitterStats,
+    /// How late the same writes completed (the port's time added: a PTY write wakes the
+    /// reader).
+    pub written_jitter: JitterStats,
     /// The device's last Telemetry.
     pub telemetry: Option<Telemetry>,
     /// The device's HelloAck.
@@ -180,10 +256,20 @@ pub struct Summary {
     pub host_rx: RxStats,
     /// Times a due batch had to wait for credit.
     pub credit_stalls: u64,
+    /// What the device reported serving, against the prediction (`served.csv`).
+    pub served: ServedStats,
     /// The register settings of the images.
     pub image_settings: ImageSettings,
     /// Time from Start to the end.
     pub elapsed: Duration,
+}
+
+/// Worst-case wire bytes of a batch frame of `n` items of `item_len` bytes each (22 for an
+/// image, 53 for a kinematics sample): header, first index, items, CRC, worst-case COBS and
+/// both delimiters.
+pub fn batch_wire_len(n: usize, item_len: usize) -> usize {
+    use margemu_protocol::link::{max_wire_len, CRC_LEN, HEADER_LEN};
+    max_wire_len(HEADER_LEN + 8 + n * item_len + CRC_LEN)
 }
 
 /// Opens a serial port for a session (no exclusive lock, 50 ms read timeout).
@@ -198,6 +284,14 @@ pub fn open_port(path: &str, baud: u32) -> Result<serialport::TTYPort, StreamErr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn batch_sizes_agree_with_the_protocol() {
+        use margemu_protocol::link::{image_batch_wire_len, IMAGE_LEN, TRUTH_LEN};
+        assert_eq!(batch_wire_len(32, IMAGE_LEN), image_batch_wire_len(32));
+        assert_eq!(batch_wire_len(32, IMAGE_LEN), 727);
+        assert_eq!(batch_wire_len(28, TRUTH_LEN), 1510); // docs/spec/link.md §9
+    }
 
     #[test]
     fn jitter_percentiles_by_nearest_rank() {

@@ -1,6 +1,8 @@
 //! The receiving half of a session: a thread that reads the port, feeds the link's
 //! [`Accumulator`], and turns every frame outcome into an owned [`RxEvent`] on a channel, so the
-//! pacing loop never blocks on the port.
+//! pacing loop never blocks on the port. Every device → host message is passed on (HelloAck,
+//! Credit, Telemetry, RegisterWrites, Reset, Error, Served); a host → device kind coming back
+//! is counted as rejected.
 //!
 //! The thread ends when the port reports end of file or an error (a vanished device), or when
 //! the session sets the shutdown flag (checked whenever a read returns, so the reader must time
@@ -8,7 +10,7 @@
 
 use margemu_protocol::link::{
     Accumulator, Credit, ErrorReport, FeedResult, FrameRepr, HelloAck, Message, RegisterWrite,
-    Reset, RxStats, SeqTracker, Telemetry,
+    Reset, RxStats, SeqTracker, ServedSample, Telemetry,
 };
 use std::io::{self, Read};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -36,6 +38,15 @@ pub enum DeviceMessage {
     Reset(Reset),
     /// The device refused something.
     Error(ErrorReport),
+    /// What the chip presented at consecutive sample instants.
+    Served {
+        /// Output sample index of the first entry.
+        first_index: u64,
+        /// Device scene time at which the first entry was served.
+        first_time_ns: u64,
+        /// One entry per instant: CRC-32C of the image latched, underrun and empty flags.
+        samples: Vec<ServedSample>,
+    },
 }
 
 /// What the reader thread saw.
@@ -90,7 +101,8 @@ pub fn spawn(
     (rx, handle)
 }
 
-fn is_transient(e: &io::Error) -> bool {
+/// A read error that only means "nothing yet" (timeout, would block, interrupted).
+pub(crate) fn is_transient(e: &io::Error) -> bool {
     matches!(
         e.kind(),
         io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock | io::ErrorKind::Interrupted
@@ -169,6 +181,11 @@ fn owned(message: &Message<'_>) -> Option<DeviceMessage> {
         },
         Message::Reset(m) => DeviceMessage::Reset(*m),
         Message::Error(m) => DeviceMessage::Error(*m),
+        Message::Served(b) => DeviceMessage::Served {
+            first_index: b.first_index,
+            first_time_ns: b.first_time_ns,
+            samples: b.samples.iter().collect(),
+        },
         _ => return None,
     })
 }

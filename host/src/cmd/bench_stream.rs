@@ -1,0 +1,128 @@
+//! `margemu bench stream`: streaming speed against error, measured here and now.
+
+use anyhow::Result;
+use margemu::perf::{link_table, stream_sweep, StreamRow};
+use margemu::stream::{JitterStats, SourceMode};
+use std::path::PathBuf;
+
+const BAUDS: [u32; 3] = [921_600, 2_000_000, 3_000_000];
+
+#[derive(clap::Args)]
+pub struct Cmd {
+    /// Seconds of scene per row (streamed in real time).
+    #[arg(long, default_value_t = 5.0)]
+    seconds: f64,
+    /// Output rates to stream, Hz.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1000,2000,4000,8000,16000,32000,64000,128000,256000"
+    )]
+    rates: Vec<f64>,
+    /// Keep the sessions' logs here (one directory per row; at 256 kHz a row writes about a GB).
+    /// Without it they go to a temporary directory, removed after each row.
+    #[arg(long)]
+    keep: Option<PathBuf>,
+}
+
+impl Cmd {
+    pub fn run(self) -> Result<()> {
+        anyhow::ensure!(
+            self.seconds > 0.0 && self.rates.iter().all(|r| *r > 0.0),
+            "--seconds and --rates must be > 0"
+        );
+        let sources = [
+            SourceMode::Images,
+            SourceMode::Model {
+                kinematics_hz: None,
+            },
+        ];
+        println!(
+            "Each row streams a {} s kinematic scene (noise on every sensor) in real time through a \
+             PTY pair to the firmware's link handler (loopback device, buffer {} samples), and checks \
+             the CRC-32C of every image it served against the host's prediction. Lost = scene \
+             samples not served byte for byte (underruns, mismatches, unreported). Pacing: how \
+             late each batch's write started against the scene clock; written: how late it \
+             completed (the PTY write included).\n",
+            self.seconds,
+            margemu::loopback::BUFFER,
+        );
+        println!(
+            "| source | rate (Hz) | samples | sent | served byte-exact | lost | of which mismatched | lead (ms) | batch | pacing late p50 / p99 / max (µs) | written late p50 / p99 / max (µs) | credit stalls | resends | link efficiency |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+        let dir = self.keep.clone().unwrap_or_else(|| {
+            std::env::temp_dir().join(format!("margemu-bench-stream-{}", std::process::id()))
+        });
+        for &source in &sources {
+            for &rate in &self.rates {
+                let row = stream_sweep(&[rate], &[source], self.seconds, &dir)?;
+                if self.keep.is_none() {
+                    std::fs::remove_dir_all(&dir)?;
+                }
+                row.iter().for_each(print_row);
+            }
+        }
+        println!(
+            "\nWorst-case link efficiency of a batch frame (header, first index, items, CRC, \
+             worst-case COBS, both delimiters) and the items per second a UART carries at 10 line \
+             bits per byte (8N1; line bytes/s: {}):\n",
+            BAUDS.map(|b| format!("{} at {b} baud", b / 10)).join(", ")
+        );
+        println!("| batch | items | wire bytes | item bytes / wire byte | 921 600 baud | 2 Mbaud | 3 Mbaud |");
+        println!("|---|---|---|---|---|---|---|");
+        for l in link_table() {
+            let kind = if l.item_len == margemu_protocol::link::IMAGE_LEN {
+                "images"
+            } else {
+                "kinematics"
+            };
+            let rates = BAUDS.map(|b| format!("{:.0} /s", l.items_per_s(b)));
+            println!(
+                "| {kind} | {} | {} | {:.1} % | {} |",
+                l.items,
+                l.wire_bytes,
+                100.0 * l.efficiency(),
+                rates.join(" | ")
+            );
+        }
+        println!(
+            "\nIn source model each kinematics sample is held for a whole number of output samples, \
+             so the output rate is that many times the kinematics rate the line carries."
+        );
+        Ok(())
+    }
+}
+
+fn print_row(r: &StreamRow) {
+    let source = match r.source {
+        SourceMode::Images => "images".to_string(),
+        SourceMode::Model { kinematics_hz } => {
+            format!("model, kinematics {} Hz", kinematics_hz.unwrap_or(0.0))
+        }
+    };
+    let s = r.served;
+    let us = |j: JitterStats| {
+        let [a, b, c] = [j.p50_ns, j.p99_ns, j.max_ns].map(|ns| ns as f64 / 1e3);
+        format!("{a:.1} / {b:.1} / {c:.1}")
+    };
+    println!(
+        "| {source} | {} | {} | {} | {} | {} | {} | {:.0} | {} | {} | {} | {} | {} | {:.1} % |{}",
+        r.rate_hz,
+        r.samples,
+        r.sent,
+        s.byte_exact,
+        s.lost(),
+        s.mismatched,
+        r.lead.as_secs_f64() * 1e3,
+        r.batch,
+        us(r.jitter),
+        us(r.written_jitter),
+        r.credit_stalls,
+        r.resends,
+        100.0 * r.efficiency,
+        r.error
+            .as_deref()
+            .map_or(String::new(), |e| format!(" ended: {e}")),
+    );
+}
