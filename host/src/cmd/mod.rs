@@ -2,8 +2,8 @@
 
 pub mod analyze;
 pub mod bench;
-pub mod evaluate;
 mod bench_stream;
+pub mod evaluate;
 pub mod filter;
 pub mod loopback;
 pub mod ports;
