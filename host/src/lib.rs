@@ -15,9 +15,11 @@
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
 //! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs;
 //! - [`evaluate`](mod@evaluate): scores of a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned and split by phase.
-//! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged.
+//! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged;
+//! - [`offline`]: the reference filters (`margemu-filters`) run over recorded samples, estimates written;
+//! - [`tune`](mod@tune): a filter's parameters tuned on a scene over several seeds (Nelder–Mead, eq. 27);
+//! - [`vfc`]: a virtual flight controller on the loopback device (the `mpu9250` driver, a reference filter, MAVLink out);
 //! - [`demo`]: the case study through loopback with the virtual flight controller (Table 3).
-//! - [`vfc`]: a virtual flight controller on the loopback device (the `mpu9250` driver, a reference filter, MAVLink out).
 #![warn(missing_docs)]
 
 pub mod analysis;
@@ -30,6 +32,7 @@ pub mod evaluate;
 pub mod loopback;
 pub mod marg;
 pub mod motion;
+pub mod offline;
 pub mod output;
 pub mod perf;
 pub mod reference;
@@ -37,4 +40,5 @@ pub mod run;
 pub mod scene;
 pub mod stream;
 pub mod truth;
+pub mod tune;
 pub mod vfc;

@@ -5,11 +5,13 @@ pub mod bench;
 mod bench_stream;
 pub mod demo;
 pub mod evaluate;
+pub mod filter;
 pub mod loopback;
 pub mod ports;
 pub mod scene;
 pub mod simulate;
 pub mod stream;
+pub mod tune;
 mod vfc;
 
 /// Every subcommand.
@@ -36,6 +38,10 @@ pub enum Command {
     Evaluate(evaluate::Cmd),
     /// The paper's case study through loopback with the virtual flight controller: Table 3.
     Demo(demo::Cmd),
+    /// Run a reference filter (ECF, GDA, EKF) offline over a recording; write its estimates.
+    Filter(filter::Cmd),
+    /// Tune a reference filter's parameters on a scene over several seeds (eq. 27, Table 3).
+    Tune(tune::Cmd),
 }
 
 impl Command {
@@ -50,6 +56,8 @@ impl Command {
             Command::Ports(c) => c.run(),
             Command::Evaluate(c) => c.run(),
             Command::Demo(c) => c.run(),
+            Command::Filter(c) => c.run(),
+            Command::Tune(c) => c.run(),
         }
     }
 }
