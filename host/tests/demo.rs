@@ -22,11 +22,17 @@ fn scratch(name: &str) -> PathBuf {
 fn demo(name: &str, tuned: &str) -> (Output, String, PathBuf) {
     let dir = scratch(name);
     std::fs::write(dir.join("tuned.toml"), tuned).unwrap();
+    let tuned = dir.join("tuned.toml");
+    demo_with(&dir, &["--tuned", tuned.to_str().unwrap()])
+}
+
+/// `margemu demo` on the case study shortened to 1 s with `args`, into `dir/out`.
+fn demo_with(dir: &std::path::Path, args: &[&str]) -> (Output, String, PathBuf) {
     let out_dir = dir.join("out");
     let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
         .arg("demo")
-        .args(["--scene", CASE_STUDY, "--duration", "1", "--tuned"])
-        .arg(dir.join("tuned.toml"))
+        .args(["--scene", CASE_STUDY, "--duration", "1"])
+        .args(args)
         .arg("-o")
         .arg(&out_dir)
         .output()
@@ -104,4 +110,34 @@ fn a_tuned_file_without_a_filters_table_stops_the_demo_before_streaming() {
     assert!(text.contains("the tuned parameters of gda: "), "{text}");
     assert!(text.contains("tuned.toml has no [gda] table"), "{text}");
     assert!(!out_dir.join("ecf-initial").exists(), "nothing streamed");
+}
+
+#[test]
+fn without_a_file_the_demo_tunes_in_process_first() {
+    let dir = scratch("tuner");
+    let (out, text, out_dir) = demo_with(
+        &dir,
+        &["--filters", "gda", "--seeds", "2", "--max-evals", "12"],
+    );
+    assert!(out.status.success(), "{text}");
+    // The tuner ran on the shortened scene, seeds 2021 and 2022, before streaming.
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("tuned gda on seeds [2021, 2022] in "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("mean F "), "{line}");
+    let f: Vec<f64> = line
+        .split("mean F ")
+        .nth(1)
+        .unwrap()
+        .split(" (")
+        .next()
+        .unwrap()
+        .split(" -> ")
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(f[1] <= f[0], "{line}");
+    assert!(text.contains("GDA initial"), "{text}");
+    assert!(text.contains("GDA tuned"), "{text}");
+    assert!(out_dir.join("gda-tuned/report.md").is_file());
 }

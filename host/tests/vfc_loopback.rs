@@ -4,11 +4,10 @@
 //! truth with `margemu evaluate`'s library.
 
 use margemu::evaluate::Evaluation;
+use margemu::offline::{FilterKind, FilterParams};
 use margemu::scene::Scene;
 use margemu::stream::StreamConfig;
-use margemu::vfc::{
-    run_loopback, FilterKind, FilterParams, MagAlignment, OutputRate, VfcConfig, VfcRun,
-};
+use margemu::vfc::{run_loopback, MagAlignment, OutputRate, VfcConfig, VfcRun};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 

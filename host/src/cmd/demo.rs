@@ -1,12 +1,14 @@
 //! `margemu demo`: the paper's case study through loopback with the virtual flight controller,
-//! every filter with its initial and tuned parameters, and the Table 3 analogue (library:
-//! `margemu::demo`).
+//! every filter with its initial and tuned parameters (the tuner run in process on the scene,
+//! or a parameters file), and the Table 3 analogue (library: `margemu::demo`).
 
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use margemu::demo::{self, table, DemoOptions, Variant};
+use margemu::offline::{FilterKind, FilterParams};
 use margemu::scene::Scene;
-use margemu::vfc::{FilterKind, FilterParams};
+use margemu::tune::{self as tuner, Dataset, TuneOptions};
+use margemu::vfc::describe;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -23,12 +25,18 @@ pub struct Cmd {
     /// Shorten the scene to this many seconds (each run streams in real time).
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
-    /// Tuned parameters (TOML with [ecf], [gda] and [ekf] tables); without it only the initial
-    /// parameters run.
+    /// Tuned parameters from this file (TOML with [ecf], [gda] and [ekf] tables, as `margemu
+    /// tune --write-params` writes it) instead of tuning on the scene.
     #[arg(long, value_name = "FILE")]
     tuned: Option<PathBuf>,
-    /// The filters to run.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "ecf,gda,ekf")]
+    /// Tuning: seeds of the scene the objective (mean F, eq. 27) is averaged over.
+    #[arg(long, default_value_t = 4, conflicts_with = "tuned")]
+    seeds: usize,
+    /// Tuning: budget of objective evaluations per filter.
+    #[arg(long, default_value_t = 200, conflicts_with = "tuned")]
+    max_evals: usize,
+    /// The filters to run: ecf, gda, ekf (comma list).
+    #[arg(long, value_delimiter = ',', default_value = "ecf,gda,ekf")]
     filters: Vec<FilterKind>,
     /// Skip the figures.
     #[arg(long)]
@@ -38,18 +46,51 @@ pub struct Cmd {
 /// Tuned parameters from a file: each filter's table must be there.
 fn from_file(
     path: &Path,
-) -> Result<impl FnMut(&Scene, FilterKind) -> Result<FilterParams, String>> {
+) -> Result<Box<dyn FnMut(&Scene, FilterKind) -> Result<FilterParams, String>>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let tables: toml::Table = text
         .parse()
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let path = path.to_path_buf();
-    Ok(move |_: &Scene, kind: FilterKind| {
+    Ok(Box::new(move |_: &Scene, kind: FilterKind| {
         if !tables.contains_key(kind.name()) {
             return Err(format!("{} has no [{kind}] table", path.display()));
         }
         FilterParams::from_toml(&text, &path, kind).map_err(|e| e.to_string())
+    }))
+}
+
+/// Tuned parameters from the tuner, in process: the scene simulated once for all filters, the
+/// tuner's defaults otherwise (warm-up 1 s, at most a quarter of the scene).
+fn from_tuner(
+    seeds: usize,
+    max_evals: usize,
+) -> Box<dyn FnMut(&Scene, FilterKind) -> Result<FilterParams, String>> {
+    let mut data: Option<Dataset> = None;
+    Box::new(move |scene: &Scene, kind: FilterKind| {
+        let opts = TuneOptions {
+            seeds,
+            max_evals,
+            warmup_s: TuneOptions::default()
+                .warmup_s
+                .min(scene.spec.duration / 4.0),
+            ..TuneOptions::default()
+        };
+        if data.is_none() {
+            data = Some(Dataset::simulate(scene, seeds).map_err(|e| e.to_string())?);
+        }
+        let data = data.as_ref().expect("simulated above");
+        let r = tuner::tune_dataset(data, kind, &opts, &|_| {}).map_err(|e| e.to_string())?;
+        println!(
+            "tuned {kind} on seeds {:?} in {} evaluations: mean F {:.4} -> {:.4} ({})",
+            r.seeds,
+            r.search.evaluations,
+            r.initial.mean(|s| s.f),
+            r.tuned.mean(|s| s.f),
+            describe(&r.tuned.params)
+        );
+        Ok(r.tuned.params)
     })
 }
 
@@ -62,19 +103,21 @@ impl Cmd {
             }
             scene = demo::shorten(&scene, seconds)?;
         }
-        let mut tuned = self.tuned.as_deref().map(from_file).transpose()?;
+        let mut tuned = match &self.tuned {
+            Some(path) => from_file(path)?,
+            None => from_tuner(self.seeds, self.max_evals),
+        };
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
         ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
             .context("installing the Ctrl-C handler")?;
         let (over, n, max) = demo::gyro_clipping(&scene)?;
-        let runs_per_filter = if tuned.is_some() { 2 } else { 1 };
         println!(
             "demo: {} ({} s at {} Hz) through loopback with the virtual flight controller: {} run(s) in real time",
             scene.path.display(),
             scene.spec.duration,
             scene.clock.hz(),
-            runs_per_filter * self.filters.len()
+            2 * self.filters.len()
         );
         println!(
             "the scene's body rate reaches {max:.1} rad/s; the chip's widest gyro range (±2000 °/s = ±34.9 rad/s) clips {over} of {n} samples ({:.2} %)",
@@ -90,8 +133,7 @@ impl Cmd {
         bar.set_style(
             ProgressStyle::with_template("{msg:12} {bar:30} {pos}/{len}").expect("valid"),
         );
-        let tuned = tuned.as_mut().map(|f| f as &mut demo::Tuned<'_>);
-        let runs = demo::run(&options, tuned, &stop, |label, p| {
+        let runs = demo::run(&options, Some(&mut *tuned), &stop, |label, p| {
             bar.set_message(label.to_string());
             bar.set_length(p.total);
             bar.set_position(p.sent);
@@ -104,7 +146,7 @@ impl Cmd {
                  ({} warm-up, {} missed); latency {:.2} ms; {}",
                 r.kind,
                 r.variant.name(),
-                r.params.describe(),
+                describe(&r.params),
                 r.served.0,
                 r.served.1,
                 r.fc.samples,
@@ -120,9 +162,6 @@ impl Cmd {
             if let Some(line) = table::ordering(&runs, variant) {
                 println!("{line}");
             }
-        }
-        if runs_per_filter == 1 {
-            println!("tuned parameters: pass --tuned FILE ([ecf], [gda], [ekf] tables)");
         }
         let md = self.output.join("table3.md");
         std::fs::write(&md, table::render(&runs, true))

@@ -4,8 +4,9 @@
 
 use anyhow::{Context, Result};
 use margemu::dut::DutSummary;
+use margemu::offline::{FilterKind, FilterParams};
 use margemu::scene::Scene;
-use margemu::vfc::{FcOutcome, FilterKind, FilterParams, OutputRate, VfcConfig};
+use margemu::vfc::{FcOutcome, OutputRate, VfcConfig};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -13,7 +14,7 @@ pub struct VfcArgs {
     /// Run a virtual flight controller with this filter on the emulated chip: the `mpu9250`
     /// driver over the virtual bus, MAVLink ATTITUDE/ATTITUDE_QUATERNION read back through a
     /// second PTY pair into dut_*.csv and scored at the end.
-    #[arg(long, value_enum, conflicts_with = "dut")]
+    #[arg(long, conflicts_with = "dut", value_name = "ecf|gda|ekf")]
     pub vfc: Option<FilterKind>,
     /// The filter's parameters (TOML: [ecf] kp, ki; [gda] beta; [ekf] gyro_noise,
     /// gyro_bias_walk, accel_noise, mag_noise); absent keys keep the defaults.
@@ -31,7 +32,11 @@ impl VfcArgs {
             return Ok(None);
         };
         let filter = match &self.vfc_params {
-            Some(path) => FilterParams::load(path, kind)?,
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .with_context(|| format!("reading {}", path.display()))?;
+                FilterParams::from_toml(&text, path, kind)?
+            }
             None => FilterParams::defaults(kind),
         };
         Ok(Some(VfcConfig {

@@ -10,18 +10,17 @@
 //! scene ([`shorten`]) keeps a test in seconds. Every sample's estimate is sent (the paper scores
 //! every epoch).
 //!
-//! **Tuned parameters** come from the caller ([`Tuned`]): a parameters file today, the tuner
-//! (`tune::tune`) once it is in: a closure from the scene and the filter to
-//! [`FilterParams`].
+//! **Tuned parameters** come from the caller ([`Tuned`]: a closure from the scene and the
+//! filter to [`FilterParams`]): `margemu demo` runs the tuner ([`crate::tune`]) in process on
+//! the scene, or reads a parameters file.
 
 pub mod table;
 
 use crate::evaluate::{EvalError, Scores};
+use crate::offline::{FilterKind, FilterParams};
 use crate::scene::{Scene, SceneError};
 use crate::stream::{Progress, StreamConfig};
-use crate::vfc::{
-    run_loopback, FcReport, FilterKind, FilterParams, OutputRate, VfcConfig, VfcError,
-};
+use crate::vfc::{run_loopback, FcReport, OutputRate, VfcConfig, VfcError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -199,7 +198,7 @@ fn one(
     let _ = std::fs::remove_dir_all(dir);
     let config = VfcConfig {
         output: OutputRate::EverySample,
-        ..VfcConfig::for_scene(&options.scene, params)
+        ..VfcConfig::for_scene(&options.scene, params.clone())
     };
     let stream = StreamConfig::default();
     let run =

@@ -4,7 +4,7 @@
 
 use super::{DemoRun, Variant};
 use crate::evaluate::Scores;
-use crate::vfc::FilterKind;
+use crate::offline::FilterKind;
 
 /// One row of the paper's Table 3 per filter: `[initial, tuned]`.
 struct PaperRow {

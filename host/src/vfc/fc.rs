@@ -30,7 +30,8 @@ use super::uart::UartTx;
 use super::{OutputRate, VfcConfig};
 use crate::dut::mavlink_out::{attitude, attitude_quaternion, MavlinkWriter};
 use crate::loopback::Firmware;
-use margemu_filters::{AttitudeFilter, Diagnostics, Imu};
+use crate::offline::ParamError;
+use margemu_filters::{AttitudeFilter, Diagnostics, Imu, Initial};
 use margemu_protocol::link::DeviceState;
 use margemu_protocol::regmap::image::ImageConfig;
 use mavlink::dialects::common::{
@@ -102,11 +103,17 @@ impl VirtualFc {
         expected: ImageConfig,
         uart: UartTx,
         report: Arc<Mutex<FcReport>>,
-    ) -> Result<Self, margemu_filters::Error> {
-        let filter = config.filter.build(config.mag_reference)?;
+    ) -> Result<Self, ParamError> {
+        let filter = config
+            .filter
+            .build(config.mag_reference, Initial::FirstSample)?;
         {
             let mut r = report.lock().unwrap_or_else(|e| e.into_inner());
-            r.filter = format!("{} ({})", config.filter.kind(), config.filter.describe());
+            r.filter = format!(
+                "{} ({})",
+                config.filter.kind(),
+                super::describe(&config.filter)
+            );
             r.bus = super::board::BUS;
         }
         Ok(Self {
@@ -203,7 +210,7 @@ impl VirtualFc {
         self.filter = self
             .config
             .filter
-            .build(self.config.mag_reference)
+            .build(self.config.mag_reference, Initial::FirstSample)
             .map_err(|e| e.to_string())?;
         self.last_ns = None;
         self.last_read_ns = None;

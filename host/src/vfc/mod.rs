@@ -14,8 +14,9 @@
 //!   from the chip's registers, never from the host's predicted samples;
 //! - [`axes`]: the driver's units to SI, the AK8963's axes to the body frame
 //!   ([`MagAlignment`]);
-//! - [`params`]: the filter (ECF, GDA or EKF of `margemu-filters`, `f64`) with its defaults or
-//!   a parameters file;
+//! - the filter: ECF, GDA or EKF of `margemu-filters` in `f64`, with the parameters of
+//!   [`crate::offline::FilterParams`] (defaults, or a parameters file as `margemu tune` writes
+//!   it), starting from its first sample;
 //! - [`uart`]: the MAVLink 2 frames ([`crate::dut::mavlink_out`]) are queued to a thread that
 //!   writes them to one end of a second pseudo-terminal pair;
 //! - [`rig`]: the device with its flight controller on a PTY, the host end of the flight
@@ -29,15 +30,14 @@
 pub mod axes;
 pub mod board;
 pub mod fc;
-pub mod params;
 pub mod rig;
 pub mod uart;
 
 pub use axes::MagAlignment;
 pub use fc::{FcReport, VirtualFc};
-pub use params::{FilterKind, FilterParams};
 pub use rig::{attach, run_loopback, spawn, AttachedDut, FcOutcome, VfcError, VfcRig, VfcRun};
 
+use crate::offline::FilterParams;
 use crate::scene::Scene;
 use crate::stream::ImageSettings;
 use std::fmt;
@@ -85,7 +85,7 @@ impl FromStr for OutputRate {
 }
 
 /// What the flight controller runs and sends.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct VfcConfig {
     /// The filter and its parameters.
     pub filter: FilterParams,
@@ -111,6 +111,15 @@ impl VfcConfig {
             sample_rate_hz: scene.clock.hz(),
         }
     }
+}
+
+/// `kp = 0.5, ki = 0`: a filter's parameters, for reports.
+pub fn describe(params: &FilterParams) -> String {
+    let parts: Vec<String> = params
+        .iter()
+        .map(|(spec, v)| format!("{} = {v}", spec.name))
+        .collect();
+    parts.join(", ")
 }
 
 /// The image settings for a chip the flight controller sets up: its full scales

@@ -31,7 +31,7 @@ pub enum VfcError {
     /// cannot open a pseudo-terminal pair or start a thread
     Io(#[source] std::io::Error),
     /// the flight controller's filter refuses its parameters: {0}
-    Filter(margemu_filters::Error),
+    Filter(crate::offline::ParamError),
     /// {0}
     Stream(#[from] StreamError),
     /// {0}
@@ -100,7 +100,7 @@ pub fn spawn(
 ) -> Result<(VfcRig, TTYPort), VfcError> {
     config
         .filter
-        .build(config.mag_reference)
+        .build(config.mag_reference, margemu_filters::Initial::FirstSample)
         .map_err(VfcError::Filter)?;
     let (fc_end, mut host_end) = TTYPort::pair().map_err(|e| VfcError::Io(e.into()))?;
     host_end
