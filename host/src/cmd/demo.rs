@@ -44,9 +44,7 @@ pub struct Cmd {
 }
 
 /// Tuned parameters from a file: each filter's table must be there.
-fn from_file(
-    path: &Path,
-) -> Result<Box<dyn FnMut(&Scene, FilterKind) -> Result<FilterParams, String>>> {
+fn from_file(path: &Path) -> Result<Box<demo::Tuned<'static>>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let tables: toml::Table = text
@@ -63,10 +61,7 @@ fn from_file(
 
 /// Tuned parameters from the tuner, in process: the scene simulated once for all filters, the
 /// tuner's defaults otherwise (warm-up 1 s, at most a quarter of the scene).
-fn from_tuner(
-    seeds: usize,
-    max_evals: usize,
-) -> Box<dyn FnMut(&Scene, FilterKind) -> Result<FilterParams, String>> {
+fn from_tuner(seeds: usize, max_evals: usize) -> Box<demo::Tuned<'static>> {
     let mut data: Option<Dataset> = None;
     Box::new(move |scene: &Scene, kind: FilterKind| {
         let opts = TuneOptions {

@@ -13,7 +13,7 @@
 //!    after set-up; a start without it would take yaw 0); the samples before are counted as
 //!    warm-up.
 //! 3. The output: at the configured rate on the device clock, or after every sample, an
-//!    ATTITUDE and an ATTITUDE_QUATERNION (MAVLink 2, [`mavlink_out`]) with `time_boot_ms` =
+//!    ATTITUDE and an ATTITUDE_QUATERNION (MAVLink 2, [`crate::dut::mavlink_out`]) with `time_boot_ms` =
 //!    the sample's instant; a HEARTBEAT every second. Frames go to the UART queue.
 //!
 //! **Time.** The flight controller's clock is the device's scene clock: a data-ready edge
