@@ -4,7 +4,9 @@
 #![allow(dead_code)]
 
 use margemu::dut::{DutProgress, DutReader};
+use margemu::truth::geodesic_angle;
 use margemu_model::rng::{below, stream, StreamRng};
+use mavlink::dialects::common::MavMessage;
 use serialport::{SerialPort, TTYPort};
 use std::io::{ErrorKind, Write};
 use std::path::{Path, PathBuf};
@@ -158,4 +160,71 @@ pub fn quat_of(e: [f64; 3]) -> [f64; 4] {
         cp * st * cs + sp * ct * ss,
         cp * ct * ss - sp * st * cs,
     ]
+}
+
+/// Standard gravity (MAVLink's milli-g).
+pub const G: f64 = 9.80665;
+
+/// The margemu quaternion of a NED/FRD one, normalized.
+pub fn from_ned_q(q: [f32; 4]) -> [f64; 4] {
+    let q = q.map(f64::from);
+    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    [q[0] / n, q[1] / n, -q[2] / n, -q[3] / n]
+}
+
+/// ZYX Euler angles of a unit quaternion (an independent formula, away from gimbal lock).
+pub fn euler_of(q: [f64; 4]) -> [f64; 3] {
+    let [w, x, y, z] = q;
+    [
+        (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y)),
+        (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin(),
+        (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z)),
+    ]
+}
+
+pub fn check_attitude(row: &[String], m: &MavMessage) {
+    match m {
+        MavMessage::ATTITUDE(d) => {
+            assert_eq!(num(&row[3]), f64::from(d.time_boot_ms) * 1000.0);
+            // Roll stays, pitch and yaw change sign: exact.
+            let e = [f64::from(d.roll), -f64::from(d.pitch), -f64::from(d.yaw)];
+            assert_eq!(nums::<3>(row, 4), e, "{row:?}");
+            assert!(geodesic_angle(&nums::<4>(row, 7), &quat_of(e)) < 1e-14);
+        }
+        MavMessage::ATTITUDE_QUATERNION(d) => {
+            let q = from_ned_q([d.q1, d.q2, d.q3, d.q4]);
+            close(&nums::<4>(row, 7), &q, 1e-15, "quaternion");
+            close(&nums::<3>(row, 4), &euler_of(q), 1e-9, "euler");
+        }
+        _ => unreachable!(),
+    }
+}
+
+pub fn check_imu(row: &[String], m: &MavMessage) {
+    let frd = |v: [f64; 3], k: f64| [v[0] * k, -v[1] * k, -v[2] * k];
+    let (t, a, g, b) = match m {
+        MavMessage::SCALED_IMU(d) => {
+            let v = |x: i16, y: i16, z: i16| [x, y, z].map(f64::from);
+            (
+                f64::from(d.time_boot_ms) * 1000.0,
+                frd(v(d.xacc, d.yacc, d.zacc), G / 1000.0),
+                frd(v(d.xgyro, d.ygyro, d.zgyro), 1e-3),
+                frd(v(d.xmag, d.ymag, d.zmag), 0.1),
+            )
+        }
+        MavMessage::HIGHRES_IMU(d) => {
+            let v = |x: f32, y: f32, z: f32| [x, y, z].map(f64::from);
+            (
+                d.time_usec as f64,
+                frd(v(d.xacc, d.yacc, d.zacc), 1.0),
+                frd(v(d.xgyro, d.ygyro, d.zgyro), 1.0),
+                frd(v(d.xmag, d.ymag, d.zmag), 100.0),
+            )
+        }
+        _ => unreachable!(),
+    };
+    assert_eq!(num(&row[3]), t);
+    close(&nums::<3>(row, 4), &a, 1e-12, "accel");
+    close(&nums::<3>(row, 7), &g, 1e-15, "gyro");
+    close(&nums::<3>(row, 10), &b, 1e-12, "mag");
 }
