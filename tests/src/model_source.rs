@@ -90,7 +90,7 @@ impl ModelStream {
         margemu::run::for_each(scene, |t| {
             let k = out_instants.len() as u64;
             out_instants.push(t.t_ns);
-            if k % u64::from(decimation) == 0 {
+            if k.is_multiple_of(u64::from(decimation)) {
                 let f = |v: [f64; 3]| v.map(|x| x as f32);
                 kinematics.push(Truth {
                     angular_rate: f(t.body_rate),

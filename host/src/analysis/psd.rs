@@ -47,7 +47,7 @@ pub fn welch(y: &[f64], rate: f64, len: usize) -> Psd {
         .iter()
         .enumerate()
         .map(|(i, a)| {
-            let one_sided = if i == 0 || (len % 2 == 0 && i == bins - 1) {
+            let one_sided = if i == 0 || (len.is_multiple_of(2) && i == bins - 1) {
                 1.0
             } else {
                 2.0
