@@ -4,6 +4,7 @@
 //! Used by CSV joint references (time column `t`, seconds) and by the analysis of recorded
 //! runs (time column `t_ns`, integer nanoseconds).
 
+use crate::csv_table::Table;
 use std::fmt::Display;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -73,53 +74,29 @@ pub fn read<T: TimeStamp>(
     column: &str,
     min_rows: usize,
 ) -> Result<(Vec<T>, Vec<f64>), ColumnError> {
-    let read_err = |source| ColumnError::Read {
-        path: path.to_path_buf(),
-        source,
-    };
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(read_err)?;
-    let header = reader.headers().map_err(read_err)?.clone();
-    let find = |name: &str| {
-        header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| ColumnError::MissingColumn {
-                path: path.to_path_buf(),
-                column: name.to_owned(),
-                found: header.iter().collect::<Vec<_>>().join(", "),
-            })
-    };
-    let (ti, vi) = (find(time)?, find(column)?);
+    let table = Table::open(path)?;
+    let [ti, vi] = table.columns([time, column])?;
     let (mut times, mut values) = (Vec::<T>::new(), Vec::new());
-    for record in reader.records() {
-        let record = record.map_err(read_err)?;
-        let line = record.position().map_or(0, |p| p.line());
-        let bad = |reason: String| ColumnError::BadRow {
-            path: path.to_path_buf(),
-            line,
-            reason,
-        };
-        let (t_text, v_text) = (record.get(ti).unwrap_or(""), record.get(vi).unwrap_or(""));
+    table.for_each(|row| {
+        let (t_text, v_text) = (row.text(ti), row.text(vi));
         let t: T = t_text
             .parse()
             .ok()
             .filter(T::is_valid)
-            .ok_or_else(|| bad(format!("`{time}` = {t_text:?} is not a valid time")))?;
+            .ok_or_else(|| row.error(format!("`{time}` = {t_text:?} is not a valid time")))?;
         let v: f64 = v_text
             .parse()
-            .map_err(|_| bad(format!("`{column}` = {v_text:?} is not a number")))?;
+            .map_err(|_| row.error(format!("`{column}` = {v_text:?} is not a number")))?;
         if !v.is_finite() {
-            return Err(bad(format!("`{column}` = {v_text} is not finite")));
+            return Err(row.error(format!("`{column}` = {v_text} is not finite")));
         }
         if times.last().is_some_and(|&last| t <= last) {
-            return Err(bad(format!("{time} = {t} does not increase")));
+            return Err(row.error(format!("{time} = {t} does not increase")));
         }
         times.push(t);
         values.push(v);
-    }
+        Ok(())
+    })?;
     if values.len() < min_rows {
         return Err(ColumnError::TooShort {
             path: path.to_path_buf(),

@@ -26,6 +26,7 @@ pub mod analysis;
 pub mod bench;
 pub mod bus;
 pub mod csv_column;
+mod csv_table;
 pub mod demo;
 pub mod dut;
 pub mod evaluate;

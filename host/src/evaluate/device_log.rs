@@ -11,8 +11,8 @@
 //! both in the MPU-9250's accel/gyro axes (the plate's axes: the chip is mounted with them). What
 //! the chip clipped stays clipped: the plots show what the device under test was given.
 
-use super::table::Table;
 use crate::csv_column::ColumnError;
+use crate::csv_table::Table;
 use margemu_protocol::link::IMAGE_LEN;
 use margemu_protocol::regmap::ak8963::MagBits;
 use margemu_protocol::regmap::convert::{asa_factor, STANDARD_GRAVITY};

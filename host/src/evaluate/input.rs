@@ -14,8 +14,8 @@
 
 use super::quat::{normalize, Quat};
 use super::score::Stamped;
-use super::table::{Row, Table};
 use crate::csv_column::ColumnError;
+use crate::csv_table::{Row, Table};
 use std::path::Path;
 
 /// The truth of a run (`truth.csv`), column groups in order of samples.

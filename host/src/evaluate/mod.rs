@@ -30,7 +30,6 @@ pub mod run;
 pub mod score;
 pub mod signals;
 pub mod stats;
-mod table;
 
 pub use align::{estimate_latency, fit_clock, ClockFit, Latency, LatencySearch};
 pub use phase::{Phase, PhaseRules};
