@@ -1,8 +1,9 @@
 //! Attitude arithmetic on plain `[w, x, y, z]` arrays (Hamilton, scalar first, body to world),
 //! done by `nalgebra`'s `UnitQuaternion`: normalisation, ZYX Euler angles, interpolation and
-//! the geodesic angle. Every function treats `q` and `−q` as the same attitude.
+//! the geodesic angle (wrapping angles is `truth::wrap_angle`). Every function treats `q` and `−q`
+//! as the same attitude.
 
-use core::f64::consts::{PI, TAU};
+use crate::truth::geodesic_angle;
 use nalgebra::{Quaternion, UnitQuaternion};
 
 /// A unit quaternion `[w, x, y, z]`.
@@ -13,16 +14,6 @@ pub fn normalize(q: Quat) -> Option<UnitQuaternion<f64>> {
     let raw = Quaternion::new(q[0], q[1], q[2], q[3]);
     let norm = raw.norm();
     (norm.is_finite() && norm > 1e-12).then(|| UnitQuaternion::new_unchecked(raw / norm))
-}
-
-/// `x` wrapped into (−π, π].
-pub fn wrap(x: f64) -> f64 {
-    let r = x.rem_euclid(TAU);
-    if r > PI {
-        r - TAU
-    } else {
-        r
-    }
 }
 
 /// ZYX Euler angles `[roll, pitch, yaw]` of `q` (`R = Rz(ψ) Ry(θ) Rx(φ)`).
@@ -49,11 +40,11 @@ fn relative(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> [f64; 4] {
     ]
 }
 
-/// The rotation angle between two attitudes, `2·acos|⟨a, b⟩|` in [0, π], computed as
-/// `2·atan2(‖v‖, |w|)` of `a⁻¹ b`, which keeps its precision for small angles.
+/// The rotation angle between two attitudes in [0, π] (`truth::geodesic_angle`: `2·atan2(‖v‖,
+/// |w|)` of `a⁻¹ b`, precise for small angles; `q` and `−q` the same).
 pub fn geodesic(a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
-    let [w, x, y, z] = relative(a, b);
-    2.0 * (x * x + y * y + z * z).sqrt().atan2(w.abs())
+    let wxyz = |q: &UnitQuaternion<f64>| [q.w, q.i, q.j, q.k];
+    geodesic_angle(&wxyz(a), &wxyz(b))
 }
 
 /// The attitude a fraction `s` ∈ [0, 1] of the way from `a` to `b` along the shorter arc
@@ -79,6 +70,8 @@ pub fn interpolate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::truth::wrap_angle as wrap;
+    use core::f64::consts::PI;
 
     #[test]
     fn wrap_maps_into_the_half_open_interval() {

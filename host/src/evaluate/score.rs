@@ -30,8 +30,9 @@
 //! assert!(s.f < 1e-12); // pitch and yaw are exact, so their MSE is 0
 //! ```
 
-use super::quat::{euler, geodesic, interpolate, normalize, wrap, Quat};
+use super::quat::{euler, geodesic, interpolate, normalize, Quat};
 pub use super::stats::{AngleStats, Scores};
+use crate::truth::wrap_angle;
 use nalgebra::UnitQuaternion;
 use std::fmt;
 
@@ -331,7 +332,7 @@ impl Reference {
             t_ns: (stamp as i64 - opts.latency_ns) as u64,
             truth,
             estimate,
-            error: [0, 1, 2].map(|i| wrap(truth[i] - estimate[i])),
+            error: [0, 1, 2].map(|i| wrap_angle(truth[i] - estimate[i])),
             geodesic: geodesic(&located.q, &est.track.q[j]),
         })
     }
