@@ -131,14 +131,15 @@ fn source_model_serves_the_predicted_images_byte_for_byte() {
     let second: Vec<&str> = lines.nth(1).unwrap().split(',').collect();
     assert_eq!((second[0], second[1]), ("1", "4000000"));
     assert_eq!(second[16], "20.02", "the temperature ramp at 4 ms");
-    // Instants after the last one, served before Stop arrived, have no prediction (empty).
+    // The device stops by itself at the scene's end: exactly the scene's instants, in order,
+    // none underrun, each as predicted (an instant after the end would have an empty match).
     let rows = served_rows("model");
-    let scene_rows: Vec<_> = rows.iter().filter(|r| !r[6].is_empty()).collect();
-    assert_eq!(scene_rows.len(), 1000);
-    assert!(
-        scene_rows.iter().all(|r| r[6] == "1"),
-        "every image as predicted"
-    );
+    assert_eq!(rows.len(), 1000);
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row[1], k.to_string());
+        assert_eq!(&row[4..], ["0", "0", "1"], "sample {k}");
+    }
+    assert!(out.contains("served 1000 samples (0 underruns"), "{out}");
 }
 
 #[test]

@@ -16,8 +16,14 @@ fn long_run(duration: f64, rate: f64) {
     let s = summary.served;
     assert_eq!(s.samples, total);
     assert_eq!(
-        (s.byte_exact, s.underruns, s.mismatched, s.unreported),
-        (total, 0, 0, 0),
+        (
+            s.byte_exact,
+            s.underruns,
+            s.mismatched,
+            s.unreported,
+            s.after_end
+        ),
+        (total, 0, 0, 0, 0),
         "{s:?}"
     );
     assert_eq!(device.counters.overruns, 0);

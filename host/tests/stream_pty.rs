@@ -15,6 +15,7 @@ use margemu_protocol::link::{
     Accumulator, DeviceState, Encoder, FeedResult, FrameRepr, HelloAck, Message, ResetCause,
     MAX_WIRE_LEN,
 };
+use margemu_protocol::PROTOCOL_VERSION;
 use serialport::{SerialPort, TTYPort};
 use std::io::{Read, Write};
 use std::ops::ControlFlow;
@@ -247,9 +248,9 @@ fn the_cli_names_a_silent_port() {
     assert!(ports.status.success());
 }
 
-/// A fake device that answers Hello with a HelloAck of protocol version 2 (the real device
-/// speaks only version 1), then stays on the line until the host closes it.
-fn fake_device_of_protocol_version_2(mut port: TTYPort) -> std::thread::JoinHandle<()> {
+/// A fake device that answers Hello with a HelloAck of the next protocol version (the real
+/// device speaks only the current one), then stays on the line until the host closes it.
+fn fake_device_of_the_next_protocol_version(mut port: TTYPort) -> std::thread::JoinHandle<()> {
     port.set_timeout(Duration::from_millis(5)).unwrap();
     std::thread::spawn(move || {
         let (mut acc, mut enc) = (Accumulator::new(), Encoder::new());
@@ -269,7 +270,7 @@ fn fake_device_of_protocol_version_2(mut port: TTYPort) -> std::thread::JoinHand
                 if let FeedResult::Success { frame, .. } = r {
                     if let Ok(Message::Hello(h)) = FrameRepr::parse(&frame).map(|f| f.message) {
                         let ack = HelloAck {
-                            protocol_version: 2,
+                            protocol_version: PROTOCOL_VERSION + 1,
                             session: h.session,
                             capabilities: Device::<8>::capabilities(),
                             ..HelloAck::default()
@@ -288,13 +289,16 @@ fn fake_device_of_another_protocol_version_is_refused() {
     let scene = scene(0.1, 1000.0);
     let dir = scratch("version");
     let (host, device) = TTYPort::pair().unwrap();
-    let fake = fake_device_of_protocol_version_2(device);
+    let fake = fake_device_of_the_next_protocol_version(device);
     let session = Session::new(&scene, config(), &dir).unwrap();
     let err = session.run_on_port(host, |_| {}).unwrap_err();
     fake.join().unwrap();
     assert_eq!(
         err.to_string(),
-        "the device speaks link protocol 2, this host 1"
+        format!(
+            "the device speaks link protocol {}, this host {PROTOCOL_VERSION}",
+            PROTOCOL_VERSION + 1
+        )
     );
     let events = assert_logs_valid(&dir);
     assert!(events.iter().any(|e| e[1] == "hello_ack"));

@@ -11,7 +11,7 @@ use proptest::prelude::*;
 /// Three frames A, B, C: B is the victim.
 fn abc() -> (Vec<u8>, Vec<u8>, Vec<u8>) {
     let images = [[0x5Au8; IMAGE_LEN], [0x00; IMAGE_LEN], [0xA5; IMAGE_LEN]];
-    let a = wire(1, &Message::Start(Start { t0_ns: 7 }));
+    let a = wire(1, &Message::Start(Start::until_stop(7)));
     let b = wire(2, &Message::Images(ImageBatch::new(1 << 40, &images)));
     let c = wire(
         3,

@@ -121,19 +121,18 @@ fn model_mode_serves_the_hosts_prediction_bit_for_bit() {
         (0, 0, 0),
         "{telemetry:?}"
     );
-    // Stop reaches the device a little after the scene's end, and every instant it serves after
-    // the last one of the scene lacks its kinematics: underruns after the end, and only there.
-    assert!(telemetry.samples_served >= 2000, "{telemetry:?}");
+    // The device stops by itself at the scene's end (Start's end_index), before the host's Stop
+    // arrives: every instant of the scene served, none after it, no underrun.
     assert_eq!(
-        u64::from(telemetry.underruns),
-        telemetry.samples_served - 2000,
+        (telemetry.samples_served, telemetry.underruns),
+        (2000, 0),
         "{telemetry:?}"
     );
 
     eprintln!(
         "qemu_model: build {build:.2?}, boot + stream {streamed:.2?}: {} of {} images served \
          byte-exact (1 kHz model on the Cortex-M4F, 200 Hz kinematics); {} batches, {} credit \
-         stalls, pacing {:?}; device served {} instants, {} underruns (after the scene's end)",
+         stalls, pacing {:?}; device served {} instants, {} underruns",
         check.exact,
         check.expected,
         report.batches,

@@ -29,12 +29,14 @@
 //! waiting, with every Telemetry, and when serving stops, so the host can check byte for byte
 //! what the chip presented.
 //!
-//! **Time base.** Start { t0 } received at local time `s` sets the scene clock to
+//! **Time base.** Start { t0, end_index } received at local time `s` sets the scene clock to
 //! `t0 + (now_ns − s)`. Output sample `k` is served when the scene clock reaches
 //! `rate.sample_time_ns(k) = floor(k·den·10⁹/num)`, the first being the smallest `k` with that
 //! instant `≥ t0`; the chip is latched at that scene time, so its registers, INT pulses and
 //! AK8963 schedule run on scene time. A late poll serves the missed instants in order (at most
-//! [`MAX_CATCH_UP`] per call).
+//! [`MAX_CATCH_UP`] per call). At the instant of sample `end_index` the device stops by itself
+//! (state Stopped, a Telemetry), serving nothing for it, in either source: the scene's end does
+//! not depend on when the host's Stop arrives.
 //!
 //! **Buffering.** Each sample swaps into the chip's data registers in one step (the chip defers
 //! it while a bus transaction is in progress, so a burst never mixes two samples); the ring
@@ -155,6 +157,8 @@ struct Clock {
     start_local_ns: u64,
     t0_ns: u64,
     next_k: u64,
+    /// Start's `end_index`: the device stops at this sample's instant.
+    end_k: u64,
 }
 
 /// The link handler of one emulated chip, with a buffer of `N` samples (see the module docs).
@@ -446,6 +450,7 @@ impl<const N: usize> Core<N> {
             start_local_ns: now_ns,
             t0_ns: s.t0_ns,
             next_k: u64::try_from(k0).unwrap_or(u64::MAX),
+            end_k: s.end_index,
         });
         self.scene_now_ns = s.t0_ns;
         self.draining = false;
@@ -525,8 +530,9 @@ impl<const N: usize> Core<N> {
             if t > now || clock.next_k == u64::MAX {
                 break;
             }
-            if self.draining && self.ring.level() == 0 {
-                // Nothing left after a Stop: stop at this instant, serving nothing for it.
+            if clock.next_k >= clock.end_k || (self.draining && self.ring.level() == 0) {
+                // The scene's end, or nothing left after a Stop: stop at this instant, serving
+                // nothing for it.
                 self.clock = Some(clock);
                 self.draining = false;
                 self.state = DeviceState::Stopped;

@@ -66,7 +66,12 @@ impl Host {
     }
 
     pub fn start(&mut self, dev: &mut Dev, t0_ns: u64, now_ns: u64) {
-        self.send(dev, &Message::Start(Start { t0_ns }), now_ns);
+        self.send(dev, &Message::Start(Start::until_stop(t0_ns)), now_ns);
+    }
+
+    /// Start of a scene of `samples` output samples: the device stops by itself at its end.
+    pub fn start_scene(&mut self, dev: &mut Dev, samples: u64, now_ns: u64) {
+        self.send(dev, &Message::Start(Start::scene(0, samples)), now_ns);
     }
 }
 

@@ -78,3 +78,35 @@ fn model_images_equal_the_hosts_prediction_bit_for_bit() {
     // The window starts at the kinematics index in effect (219 ms → 43).
     assert_eq!(dev.credit().limit, 43 + CAP as u64);
 }
+
+#[test]
+fn the_model_stops_at_the_scene_end_without_underruns() {
+    let mut dev = Dev::new();
+    let mut host = Host::new();
+    host.hello(&mut dev, 1);
+    let params = ModelParams::new(SEED, Rate::hz(200).unwrap(), marg_config());
+    host.configure(
+        &mut dev,
+        Configure {
+            source: Source::Model(params),
+            ..Configure::new(0x71, Rate::hz(1000).unwrap())
+        },
+    );
+    // 40 kinematics at 200 Hz cover 200 outputs at 1 kHz: the scene's 200 samples.
+    let sent: Vec<Truth> = (0..40).map(truth).collect();
+    for (i, chunk) in sent.chunks(28).enumerate() {
+        let batch = KinematicsBatch::new(28 * i as u64, chunk);
+        host.send(&mut dev, &Message::Kinematics(batch), 0);
+    }
+    host.start_scene(&mut dev, 200, 0);
+    let mut out = Vec::new();
+    for k in 0..260u64 {
+        out.extend(poll(&mut dev, k * MS)); // the host's Stop never comes
+    }
+    let c = dev.counters();
+    assert_eq!((c.served, c.underruns), (200, 0));
+    assert_eq!(dev.last_served().unwrap().index, 199);
+    let t = telemetry(&out).unwrap();
+    assert_eq!(t.state, margemu_protocol::link::DeviceState::Stopped);
+    assert_eq!(t.time_ns, 200 * MS);
+}

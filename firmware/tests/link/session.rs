@@ -75,7 +75,7 @@ fn refusals_are_answered_and_counted() {
     let mut host = Host::new();
     host.hello(&mut dev, 1);
     poll(&mut dev, 0);
-    host.send(&mut dev, &Message::Start(Start { t0_ns: 0 }), 0);
+    host.send(&mut dev, &Message::Start(Start::until_stop(0)), 0);
     host.configure(&mut dev, Configure::new(0x42, rate_1khz()));
     let mut p = ModelParams::new(1, rate_1khz(), MargConfig::default());
     p.perturbation = Some(PerturbationConfig::default());

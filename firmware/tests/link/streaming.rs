@@ -130,6 +130,50 @@ fn underrun_holds_the_last_sample_and_is_counted() {
 }
 
 #[test]
+fn the_scene_end_stops_the_device_at_its_instant_however_late_stop_comes() {
+    let (mut dev, mut host) = configured();
+    // More images than the scene holds: the device still stops at the scene's end.
+    host.images(&mut dev, 0, &images(0, 8), 0);
+    host.start_scene(&mut dev, 5, 0);
+    let out = poll(&mut dev, 20 * MS); // no Stop: the host's Stop is late
+    let flags: Vec<_> = served(&out).iter().map(|(k, s)| (*k, s.underrun)).collect();
+    assert_eq!(flags, (0..5).map(|k| (k, false)).collect::<Vec<_>>());
+    let t = telemetry(&out).expect("a Telemetry when the device stops");
+    assert_eq!(t.state, DeviceState::Stopped);
+    assert_eq!((t.samples_served, t.underruns), (5, 0));
+    assert_eq!((t.last_served_index, t.time_ns), (4, 5 * MS));
+    assert_eq!(
+        burst_sensors(&mut dev),
+        image(4)[..14],
+        "holds the last sample"
+    );
+    // The late Stop only confirms it.
+    host.send(&mut dev, &Message::Stop, 30 * MS);
+    let out = poll(&mut dev, 30 * MS);
+    assert!(served(&out).is_empty());
+    let t = telemetry(&out).unwrap();
+    assert_eq!(
+        (t.state, t.samples_served, t.underruns),
+        (DeviceState::Stopped, 5, 0)
+    );
+}
+
+#[test]
+fn a_missing_last_sample_is_an_underrun_and_the_scene_still_ends() {
+    let (mut dev, mut host) = configured();
+    host.images(&mut dev, 0, &images(0, 4), 0);
+    host.start_scene(&mut dev, 5, 0);
+    let out = poll(&mut dev, 20 * MS);
+    let flags: Vec<_> = served(&out).iter().map(|(k, s)| (*k, s.underrun)).collect();
+    assert_eq!(flags, (0..5).map(|k| (k, k == 4)).collect::<Vec<_>>());
+    let t = telemetry(&out).unwrap();
+    assert_eq!(
+        (t.state, t.samples_served, t.underruns),
+        (DeviceState::Stopped, 5, 1)
+    );
+}
+
+#[test]
 fn overrun_is_counted_and_answered() {
     let (mut dev, mut host) = configured();
     host.images(&mut dev, 0, &images(0, CAP + 6), 0);

@@ -14,13 +14,14 @@
 //! 2. Configure (WHO_AM_I 0x71, the scene's exact rate, the source and, in mode (b), the model
 //!    parameters) → the first Credit;
 //! 3. prefill (the items due within the lead, as far as the window allows), then Start
-//!    (`t0_ns` = 0), which sets scene time 0 on the host's monotonic clock;
+//!    (`t0_ns` = 0, `end_index` = the scene's sample count), which sets scene time 0 on the
+//!    host's monotonic clock; the device stops by itself at the scene's end;
 //! 4. batches paced in real time (`pacing.rs`): the batch that starts at
 //!    item `j` is written at `start + t_j − lead`, never beyond the device's credit window; the
 //!    time of every write and how late it was are logged (pacing jitter). Items the device
 //!    reports missing long after they were written are written again ([`resend`]);
-//! 5. Stop after the last sample (in mode (b) once the device reports serving it), then wait
-//!    for Telemetry in the stopped state.
+//! 5. Stop after the last sample (in mode (b) once the device reports serving it), which
+//!    confirms the end, then wait for Telemetry in the stopped state.
 //!
 //! A receive thread ([`rx`]) decodes the device's frames concurrently and counts damaged ones.
 //! Every sample instant the device reports serving (its Served messages: index, CRC-32C of the

@@ -102,7 +102,9 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
                 .min(total - self.next);
             self.write_batch(n, None, false)?;
         }
-        self.send(&Message::Start(Start { t0_ns: 0 }))?;
+        // The device serves samples 0..total and stops by itself at the scene's end.
+        let total_samples = self.total();
+        self.send(&Message::Start(Start::scene(0, total_samples)))?;
         let start = Instant::now();
         self.start = Some(start);
         let start_ns = self.host_ns(start);
@@ -178,11 +180,12 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     }
 
     /// Sends Stop half an output period after the last sample's instant, on the host's clock.
-    /// In source images the device then serves what it still holds and stops (a graceful
-    /// stop), so it serves the last sample and no instant after it. In source model it stops at
-    /// once, and its clock lags the host's by the Start's delivery time, so the host first waits
-    /// until the device reports serving the last sample (the instants served meanwhile are
-    /// after the scene's end). Then it waits for Telemetry in the stopped state.
+    /// The device stops by itself at the scene's end (Start's `end_index`), so it never serves
+    /// an instant after the last sample, however late Stop arrives; Stop confirms that. In
+    /// source images a Stop that arrives early is graceful (the device serves what it still
+    /// holds). In source model it stops at once, and the device's clock lags the host's by the
+    /// Start's delivery time, so the host first waits until the device reports serving the last
+    /// sample. Then it waits for Telemetry in the stopped state.
     pub(super) fn finish(&mut self) -> Result<(), StreamError> {
         let total = self.total();
         let drain = self.session.config.drain_timeout;

@@ -38,7 +38,8 @@ pub struct ServedStats {
     pub first_mismatch: Option<u64>,
     /// Scene indices never reported (a lost Served frame, or a session that ended early).
     pub unreported: u64,
-    /// Entries for instants after the scene's last sample (served before Stop arrived).
+    /// Entries for instants after the scene's last sample (none from a device that honours
+    /// Start's `end_index`).
     pub after_end: u64,
     /// The highest index reported.
     pub last_index: Option<u64>,

@@ -14,7 +14,7 @@
 //! use margemu_protocol::link::{Accumulator, Encoder, FeedResult, FrameRepr, Message, Start};
 //! let mut enc = Encoder::new();
 //! let mut wire = [0u8; 64];
-//! let n = enc.encode(&Message::Start(Start { t0_ns: 5 }), &mut wire)?;
+//! let n = enc.encode(&Message::Start(Start::until_stop(5)), &mut wire)?;
 //! let mut acc = Accumulator::new();
 //! let mut got = None;
 //! for byte in wire[..n].chunks(1) {                // one byte at a time, as a UART would
@@ -33,7 +33,7 @@
 //!         }
 //!     }
 //! }
-//! assert_eq!(got, Some(Start { t0_ns: 5 }));
+//! assert_eq!(got, Some(Start::until_stop(5)));
 //! # Ok::<(), margemu_protocol::link::Error>(())
 //! ```
 

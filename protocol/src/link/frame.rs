@@ -16,12 +16,12 @@
 //!
 //! ```
 //! use margemu_protocol::link::{Frame, FrameRepr, Message, Start};
-//! let repr = FrameRepr { seq: 7, message: Message::Start(Start { t0_ns: 0 }) };
+//! let repr = FrameRepr { seq: 7, message: Message::Start(Start::until_stop(0)) };
 //! let mut buf = [0u8; 32];
 //! let n = repr.emit(&mut buf)?;
 //! assert_eq!(n, repr.buffer_len());
 //! let frame = Frame::new_verified(&buf[..n])?;
-//! assert_eq!((frame.seq(), frame.kind(), frame.payload_len()), (7, 0x03, 8));
+//! assert_eq!((frame.seq(), frame.kind(), frame.payload_len()), (7, 0x03, 16));
 //! assert_eq!(FrameRepr::parse(&frame)?, repr);
 //! # Ok::<(), margemu_protocol::link::Error>(())
 //! ```
@@ -294,12 +294,17 @@ mod tests {
     use super::*;
     use crate::link::{Credit, Start};
 
-    // Start { t0_ns: 0x0102030405060708 }, seq 0x1234.
-    static START: [u8; 18] = [
-        0x01, 0x03, 0x34, 0x12, 0x08, 0x00, // header
+    // Start { t0_ns: 0x0102030405060708, end_index: 0x1112131415161718 }, seq 0x1234.
+    static START: [u8; 26] = [
+        0x01, 0x03, 0x34, 0x12, 0x10, 0x00, // header
         0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01, // t0_ns
-        0x6F, 0x6D, 0x33, 0x07, // CRC-32C
+        0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11, // end_index
+        0x87, 0xB5, 0x0D, 0xF8, // CRC-32C
     ];
+    const START_MESSAGE: Start = Start {
+        t0_ns: 0x0102_0304_0506_0708,
+        end_index: 0x1112_1314_1516_1718,
+    };
 
     #[test]
     fn crc_check_value() {
@@ -312,26 +317,23 @@ mod tests {
         assert_eq!(frame.version(), 1);
         assert_eq!(frame.kind(), 0x03);
         assert_eq!(frame.seq(), 0x1234);
-        assert_eq!(frame.payload_len(), 8);
-        assert_eq!(frame.payload(), &START[6..14]);
-        assert_eq!(frame.crc(), 0x0733_6D6F);
+        assert_eq!(frame.payload_len(), 16);
+        assert_eq!(frame.payload(), &START[6..22]);
+        assert_eq!(frame.crc(), 0xF80D_B587);
         let repr = FrameRepr::parse(&frame).unwrap();
-        let t0_ns = 0x0102_0304_0506_0708;
-        assert_eq!(repr.message, Message::Start(Start { t0_ns }));
+        assert_eq!(repr.message, Message::Start(START_MESSAGE));
     }
 
     #[test]
     fn construct() {
         let repr = FrameRepr {
             seq: 0x1234,
-            message: Message::Start(Start {
-                t0_ns: 0x0102_0304_0506_0708,
-            }),
+            message: Message::Start(START_MESSAGE),
         };
-        let mut buf = [0xAAu8; 18];
-        assert_eq!(repr.emit(&mut buf), Ok(18));
+        let mut buf = [0xAAu8; 26];
+        assert_eq!(repr.emit(&mut buf), Ok(26));
         assert_eq!(buf, START);
-        assert_eq!(repr.emit(&mut buf[..17]), Err(Error::BufferTooSmall));
+        assert_eq!(repr.emit(&mut buf[..25]), Err(Error::BufferTooSmall));
     }
 
     #[test]
@@ -340,7 +342,7 @@ mod tests {
         bad[8] ^= 0x10;
         assert_eq!(Frame::new_verified(&bad[..]), Err(Error::FrameBadCrc));
         assert_eq!(
-            Frame::new_verified(&START[..17]),
+            Frame::new_verified(&START[..25]),
             Err(Error::FrameTruncated)
         );
         assert_eq!(Frame::new_verified(&START[..9]), Err(Error::FrameTruncated));

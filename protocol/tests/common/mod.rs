@@ -258,8 +258,8 @@ pub fn message() -> impl Strategy<Value = Owned> {
             }))
             .boxed()),
         m(configure().prop_map(Message::Configure).boxed()),
-        m(any::<u64>()
-            .prop_map(|t0_ns| Message::Start(Start { t0_ns }))
+        m((any::<u64>(), any::<u64>())
+            .prop_map(|(t0_ns, end_index)| Message::Start(Start { t0_ns, end_index }))
             .boxed()),
         m(Just(Message::Stop).boxed()),
         (

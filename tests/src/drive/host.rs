@@ -77,7 +77,8 @@ impl Host {
             next += n;
             batches += 1;
         }
-        self.send(&Message::Start(Start { t0_ns: 0 }))?;
+        let outputs = script.outputs;
+        self.send(&Message::Start(Start::scene(0, outputs)))?;
         let start = Instant::now();
         let mut lateness_ns = Vec::new();
         let mut credit_stalls = 0u64;

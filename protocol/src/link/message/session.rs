@@ -174,24 +174,59 @@ impl HelloAck {
 }
 
 /// Host → device: start serving. The device sets its scene clock to `t0_ns` now and serves
-/// sample `i` at scene time [`Rate::sample_time_ns`](super::Rate::sample_time_ns)`(i)`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// sample `i` at scene time [`Rate::sample_time_ns`](super::Rate::sample_time_ns)`(i)` for every
+/// `i < end_index`; at the instant of sample `end_index` it stops by itself, serving nothing for
+/// it, so a scene's end never depends on when Stop arrives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Start {
     /// Scene time at the instant the device receives this message, ns.
     pub t0_ns: u64,
+    /// The first output sample index not to serve (the scene's sample count);
+    /// [`Start::UNBOUNDED`] serves until Stop.
+    pub end_index: u64,
+}
+
+impl Default for Start {
+    /// Scene time 0, serving until Stop.
+    fn default() -> Self {
+        Self::until_stop(0)
+    }
 }
 
 impl Start {
     /// Payload length.
-    pub const LEN: usize = 8;
+    pub const LEN: usize = 16;
+
+    /// `end_index` of a session that runs until Stop.
+    pub const UNBOUNDED: u64 = u64::MAX;
+
+    /// Starts at scene time `t0_ns` and serves until Stop.
+    pub const fn until_stop(t0_ns: u64) -> Self {
+        Self {
+            t0_ns,
+            end_index: Self::UNBOUNDED,
+        }
+    }
+
+    /// Starts at scene time `t0_ns` and serves samples `0..samples` (those at or after `t0_ns`).
+    pub const fn scene(t0_ns: u64, samples: u64) -> Self {
+        Self {
+            t0_ns,
+            end_index: samples,
+        }
+    }
 
     pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
-        Ok(Self { t0_ns: r.u64()? })
+        Ok(Self {
+            t0_ns: r.u64()?,
+            end_index: r.u64()?,
+        })
     }
 
     pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
-        w.u64(self.t0_ns)
+        w.u64(self.t0_ns)?;
+        w.u64(self.end_index)
     }
 }
 
