@@ -1,6 +1,6 @@
-//! QEMU test of source mode (b): the host streams a scene's truth as Kinematics at 200 Hz to the
+//! QEMU test of source mode (b): the host streams a scene's truth as Kinematics at 100 Hz to the
 //! `qemu-mps2-an386` firmware, which runs the shared sensor model (seeded from the scene, noise
-//! and biases on) at the chip's 1 kHz output rate on the emulated Cortex-M4F. Every image it
+//! and biases on) at the chip's 500 Hz output rate on the emulated Cortex-M4F. Every image it
 //! served (its Served reports: CRC-32C per image) must equal the host's own prediction, computed
 //! on x86-64 with the same `margemu_model` code ([`ModelStream`]). Passing proves the shared model
 //! is bit-identical on both targets, noise draws included.
@@ -26,7 +26,7 @@ use margemu_tests::SENSORS;
 const MOTION: &str = r#"
 name = "qemu-model"
 duration = 2.0
-rate = 1000.0
+rate = 500.0
 seed = 5
 [bench]
 initial = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
@@ -53,7 +53,10 @@ amplitude = 0.3
 frequency = 5.0
 "#;
 
-/// Output samples per kinematics sample: 1 kHz out, 200 Hz truth.
+/// Output samples per kinematics sample: 500 Hz out, 100 Hz truth. The rates, and the lead of
+/// 1.5 s (most of the scene buffered before Start), are what QEMU's one-byte-per-turn UART
+/// sustains beside CPU hogs on a 2-core machine: this test checks bit-identity, the benchmark
+/// `qemu_rates` the speed.
 const DECIMATION: u32 = 5;
 
 #[test]
@@ -69,7 +72,7 @@ fn model_mode_serves_the_hosts_prediction_bit_for_bit() {
         .unwrap_or_else(|e| panic!("{e}"));
     let stream = ModelStream::from_scene(&scene, DECIMATION).unwrap_or_else(|e| panic!("{e}"));
     let predicted = stream.predicted_crcs();
-    assert_eq!((predicted.len(), stream.kinematics.len()), (2000, 400));
+    assert_eq!((predicted.len(), stream.kinematics.len()), (1000, 200));
     // Noise on: no two consecutive predicted images are equal, although the truth is held.
     assert!(stream.images.windows(2).all(|w| w[0] != w[1]));
 
@@ -78,7 +81,7 @@ fn model_mode_serves_the_hosts_prediction_bit_for_bit() {
         samples: Samples::Kinematics(&stream.kinematics),
         sample_rate: stream.params.truth_rate,
         outputs: predicted.len() as u64,
-        lead: Duration::from_millis(500),
+        lead: Duration::from_millis(1500),
         batch: 10,
         timeout: Duration::from_secs(5),
     };
@@ -125,13 +128,13 @@ fn model_mode_serves_the_hosts_prediction_bit_for_bit() {
     // arrives: every instant of the scene served, none after it, no underrun.
     assert_eq!(
         (telemetry.samples_served, telemetry.underruns),
-        (2000, 0),
+        (1000, 0),
         "{telemetry:?}"
     );
 
     eprintln!(
         "qemu_model: build {build:.2?}, boot + stream {streamed:.2?}: {} of {} images served \
-         byte-exact (1 kHz model on the Cortex-M4F, 200 Hz kinematics); {} batches, {} credit \
+         byte-exact (500 Hz model on the Cortex-M4F, 100 Hz kinematics); {} batches, {} credit \
          stalls, pacing {:?}; device served {} instants, {} underruns",
         check.exact,
         check.expected,

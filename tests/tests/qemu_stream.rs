@@ -8,8 +8,10 @@
 //! served at an index, compared with the CRC-32C of the predicted image. The device's final
 //! Telemetry must report no underrun and no overrun.
 //!
-//! The rate, [`RATE_HZ`], is the highest the benchmark (`tests/benches/qemu_rates.rs`, README)
-//! found QEMU's UART to sustain with margin on a shared two-core machine.
+//! The rate, [`RATE_HZ`], is a third of what the benchmark (`tests/benches/qemu_rates.rs`,
+//! README) found QEMU's UART to sustain on a quiet machine, and the lead of 1.5 s puts most of
+//! the scene in the device's buffer before Start: QEMU takes one byte per turn of its main loop,
+//! which slows far down beside CPU hogs. This test checks correctness; the benchmark the speed.
 //!
 //! Skipped, with a message, where `qemu-system-arm` or a cross toolchain is missing; under
 //! `CI=true` that is a failure instead.
@@ -25,7 +27,7 @@ use margemu_tests::served::ServedTap;
 use serialport::SerialPort;
 
 /// Output rate of the stream.
-const RATE_HZ: u32 = 500;
+const RATE_HZ: u32 = 250;
 /// Length of the scene.
 const SECONDS: f64 = 2.0;
 
@@ -48,7 +50,8 @@ fn session_streams_to_qemu_byte_for_byte() {
     let dir = scratch("stream");
     let config = StreamConfig {
         port: "qemu mps2-an386 UART0 (pty)".into(),
-        lead: Duration::from_millis(300),
+        lead: Duration::from_millis(1500),
+        drain_timeout: Duration::from_secs(5),
         ..StreamConfig::default()
     };
     let session = Session::new(&scene, config, &dir).unwrap_or_else(|e| panic!("session: {e}"));
