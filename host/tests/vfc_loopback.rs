@@ -35,8 +35,12 @@ fn gentle() -> Scene {
 /// every image byte for byte and that every frame the flight controller queued was decoded.
 fn run(name: &str, config: VfcConfig) -> (VfcRun, PathBuf) {
     let dir = scratch(name);
+    // A long lead: these tests are about the flight controller, so the session must not
+    // underrun when four of them share a loaded machine (stalls beyond the default 200 ms
+    // were seen beside 3 CPU hogs).
     let stream = StreamConfig {
         port: "pty".into(),
+        lead: std::time::Duration::from_secs(1),
         ..StreamConfig::default()
     };
     let run = run_loopback(
@@ -52,7 +56,11 @@ fn run(name: &str, config: VfcConfig) -> (VfcRun, PathBuf) {
         .session
         .as_ref()
         .unwrap_or_else(|e| panic!("{name}: {e}"));
-    assert_eq!(summary.served.byte_exact, summary.samples, "{name}");
+    assert_eq!(
+        summary.served.byte_exact, summary.samples,
+        "{name}: {:?}",
+        summary.served
+    );
     let dut = run.dut.as_ref().unwrap();
     run.fc
         .check_delivery(dut)
@@ -79,33 +87,42 @@ fn each_filter_tracks_the_truth_within_two_degrees() {
         // once), hardly any missed; the filter started at the AK8963's first measurement
         // (10 ms); 50 Hz output; a heartbeat each second.
         assert_eq!(fc.samples + fc.missed, 600, "{fc}");
-        assert!(fc.missed < 30, "{fc}");
+        assert!(fc.missed < 60, "{fc}"); // up to 26 seen beside 3 CPU hogs on 2 cores
         assert!((1..=2).contains(&fc.warmup), "{fc}");
-        assert_eq!(fc.sent.get("ATTITUDE"), Some(&150), "{fc}");
-        assert_eq!(fc.sent.get("ATTITUDE_QUATERNION"), Some(&150), "{fc}");
+        // 50 Hz output: one per 20 ms instant, sent at the first sample read at or after it. A
+        // starved flight controller thread (a loaded machine) that misses 4 samples in a row
+        // can step over an instant, as a real one would: at most one per 4 missed.
+        let attitudes = *fc.sent.get("ATTITUDE").unwrap_or(&0);
+        assert!((150 - fc.missed / 4..=150).contains(&attitudes), "{fc}");
+        assert_eq!(fc.sent.get("ATTITUDE_QUATERNION"), Some(&attitudes), "{fc}");
         assert_eq!(fc.sent.get("HEARTBEAT"), Some(&3), "{fc}");
         let init = fc.init.unwrap();
         assert_eq!((init.who_am_i, init.ak8963_wia), (0x71, 0x48));
         let eval = evaluate(&dir);
         let s = eval.scores;
         println!(
-            "{kind}: geodesic RMS {:.3}° max {:.3}°, F {:.3e}, latency {:.3} ms",
+            "{kind}: geodesic RMS {:.3}° max {:.3}°, F {:.3e}, latency {:.3} ms; {} samples missed",
             s.geodesic_rms.to_degrees(),
             s.geodesic_max.to_degrees(),
             s.f,
-            eval.latency_applied_ns as f64 * 1e-6
+            eval.latency_applied_ns as f64 * 1e-6,
+            fc.missed
         );
         assert!(s.count >= 145, "{s:?}");
         results.push((kind, s));
     }
-    // Bounds from measurement (2026-11-21, debug build, loaded machine, three runs): geodesic
-    // RMS ECF 1.19–1.21° (its default gain, 0.5, is slow to correct the yaw it integrates),
-    // GDA 0.53–0.55°, EKF 0.48°; maxima 1.9°, 1.5°, 1.3°. A wrong magnetometer axis map costs
-    // tens of degrees (below).
+    // Bounds from measurement (2026-11-21, debug build, 15 runs beside 0-3 CPU hogs on 2
+    // cores, up to 26 samples missed): geodesic RMS ECF 0.75-1.25° (its default gain, 0.5, is
+    // slow to correct the yaw it integrates), GDA 0.52-0.73°, EKF 0.39-0.52°; maxima up to
+    // 2.06°, 2.17°, 1.42°. A wrong magnetometer axis map costs tens of degrees (below).
     for (kind, s) in results {
-        let bound = if kind == FilterKind::Ecf { 2.0 } else { 1.0 };
-        assert!(s.geodesic_rms.to_degrees() < bound, "{kind}: {s:?}");
-        assert!(s.geodesic_max.to_degrees() < 2.0 * bound, "{kind}: {s:?}");
+        let (rms, max) = if kind == FilterKind::Ecf {
+            (2.0, 4.0)
+        } else {
+            (1.0, 3.0)
+        };
+        assert!(s.geodesic_rms.to_degrees() < rms, "{kind}: {s:?}");
+        assert!(s.geodesic_max.to_degrees() < max, "{kind}: {s:?}");
     }
 }
 
