@@ -15,11 +15,12 @@
 //! not observable and callers use 0. Keep `max_lag` below half the period of any periodic motion,
 //! or a whole period's shift fits as well as the true one.
 //!
-//! **Clock** ([`fit_clock`]): when the device stamps its output with its own clock, a least
-//! squares line `host_ns = offset + rate · device_time_us` through (device time, host arrival
-//! time) pairs gives the device clock's offset (the host time, on the scene's origin, at which
-//! the device clock read 0), its drift `(rate/1000 − 1)·10⁶` ppm, and the residual (how much the
-//! arrival times jitter about the line).
+//! **Clock** ([`fit_clock`]): when the device stamps its output with its own clock, the line
+//! `host_ns = offset + rate · device_time_us` under the (device time, host arrival time) pairs
+//! (their lower envelope: arrivals are late by the link's delay and by host stalls, never
+//! early) gives the device clock's offset (the host time, on the scene's origin, at which the
+//! device clock read 0, plus the link's shortest delay), its drift `(rate/1000 − 1)·10⁶` ppm,
+//! and the residual (how late the arrivals are against the line).
 
 use super::score::{Estimates, Reference, ScoreOptions};
 
@@ -174,21 +175,36 @@ impl ClockFit {
     }
 }
 
-/// The least squares line through `(device time µs, host time ns)` pairs; `None` with fewer
-/// than two distinct device times.
+/// The line under `(device time µs, host time ns)` pairs: a message arrives no earlier than
+/// the device stamped it plus the link's shortest delay, and on a loaded host some arrive
+/// tens of milliseconds late, so the device clock is the lower envelope of the pairs, not
+/// their mean. Of the lines on or below every pair, the one with the least total distance to
+/// them (the linear-programming skew estimator of Moon, Skelly and Towsley, 1999): an edge of
+/// the pairs' lower convex hull, the one spanning their mean device time. Late arrivals,
+/// however many and however clustered in time, move it only where they are the lowest pairs.
+/// `None` with fewer than two distinct device times (non-finite pairs are ignored).
 pub fn fit_clock(pairs: &[(f64, f64)]) -> Option<ClockFit> {
-    let n = pairs.len() as f64;
-    let mean_d = pairs.iter().map(|p| p.0).sum::<f64>() / n;
-    let mean_h = pairs.iter().map(|p| p.1).sum::<f64>() / n;
-    let sdd: f64 = pairs.iter().map(|p| (p.0 - mean_d).powi(2)).sum();
-    let sdh: f64 = pairs.iter().map(|p| (p.0 - mean_d) * (p.1 - mean_h)).sum();
-    if pairs.len() < 2 || sdd <= 0.0 || !sdd.is_finite() {
+    let mut points: Vec<(f64, f64)> = pairs
+        .iter()
+        .copied()
+        .filter(|p| p.0.is_finite() && p.1.is_finite())
+        .collect();
+    points.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    points.dedup_by(|later, first| later.0 == first.0); // the earliest arrival of a device time
+    let hull = lower_hull(&points);
+    if hull.len() < 2 {
         return None;
     }
-    let rate = sdh / sdd;
-    let offset_ns = mean_h - rate * mean_d;
+    let n = pairs.len() as f64;
+    let mean_d = points.iter().map(|p| p.0).sum::<f64>() / points.len() as f64;
+    let edge = hull
+        .windows(2)
+        .find(|w| w[1].0 >= mean_d)
+        .unwrap_or(&hull[hull.len() - 2..]);
+    let (a, b) = (edge[0], edge[1]);
+    let rate = (b.1 - a.1) / (b.0 - a.0);
     let fit = ClockFit {
-        offset_ns,
+        offset_ns: a.1 - rate * a.0,
         rate,
         drift_ppm: (rate / 1000.0 - 1.0) * 1e6,
         residual_rms_ns: 0.0,
@@ -202,6 +218,23 @@ pub fn fit_clock(pairs: &[(f64, f64)]) -> Option<ClockFit> {
         residual_max_ns: residuals.fold(0.0, |m, r| m.max(r.abs())),
         ..fit
     })
+}
+
+/// The lower convex hull of points sorted by x with distinct x (Andrew's monotone chain).
+fn lower_hull(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut hull: Vec<(f64, f64)> = Vec::with_capacity(points.len().min(64));
+    for &p in points {
+        while let [.., o, a] = hull[..] {
+            // Drop `a` unless o → a → p turns left (counter-clockwise).
+            let cross = (a.0 - o.0) * (p.1 - o.1) - (a.1 - o.1) * (p.0 - o.0);
+            if cross > 0.0 {
+                break;
+            }
+            hull.pop();
+        }
+        hull.push(p);
+    }
+    hull
 }
 
 #[cfg(test)]
@@ -228,5 +261,34 @@ mod tests {
         assert!(fit.residual_max_ns < 1e-3);
         assert!(fit_clock(&[(1.0, 2.0)]).is_none());
         assert!(fit_clock(&[(1.0, 2.0), (1.0, 3.0)]).is_none());
+        assert!(fit_clock(&[(1.0, 2.0), (f64::NAN, 3.0), (2.0, f64::INFINITY)]).is_none());
+        assert!(fit_clock(&[]).is_none());
+    }
+
+    #[test]
+    fn clock_fit_ignores_late_arrivals_clustered_in_time() {
+        // 2 ms of link delay; a host stall delays the last fifth by 5-45 ms, and every 7th
+        // message by up to 3 ms: a least squares line would tilt and shift by milliseconds.
+        let pairs: Vec<(f64, f64)> = (0..1000u32)
+            .map(|k| {
+                let d = f64::from(k) * 5000.0;
+                let mut late = 2e6 + f64::from(k % 13) * 1e4;
+                if k >= 800 {
+                    late += 5e6 + f64::from(k % 40) * 1e6;
+                }
+                if k % 7 == 0 {
+                    late += 3e6;
+                }
+                (d, 1e9 + d * 1000.0 + late)
+            })
+            .collect();
+        let fit = fit_clock(&pairs).unwrap();
+        assert!(fit.drift_ppm.abs() < 1.0, "{fit:?}");
+        assert!((fit.offset_ns - (1e9 + 2e6)).abs() < 1e3, "{fit:?}");
+        let below = pairs
+            .iter()
+            .filter(|p| p.1 < fit.host_ns(p.0) - 1e-3)
+            .count();
+        assert_eq!(below, 0, "no arrival before the line");
     }
 }
