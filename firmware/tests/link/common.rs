@@ -114,6 +114,11 @@ pub fn decode(mut bytes: &[u8]) -> Vec<Out> {
     out
 }
 
+/// `(index, underrun)` of every instant the device reported serving in `out`.
+pub fn underrun_flags(out: &[Out]) -> Vec<(u64, bool)> {
+    served(out).iter().map(|(k, s)| (*k, s.underrun)).collect()
+}
+
 pub fn telemetry(out: &[Out]) -> Option<Telemetry> {
     out.iter().rev().find_map(|o| match o {
         Out::Telemetry(t) => Some(*t),

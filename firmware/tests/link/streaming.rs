@@ -103,7 +103,7 @@ fn underrun_holds_the_last_sample_and_is_counted() {
     // instants, and the device stops at instant 12 without counting an underrun for it.
     host.send(&mut dev, &Message::Stop, 9 * MS);
     let out = poll(&mut dev, 20 * MS);
-    let flags: Vec<_> = served(&out).iter().map(|(k, s)| (*k, s.underrun)).collect();
+    let flags = underrun_flags(&out);
     let held = served(&out)[7].1;
     assert_eq!(held, served_entry(&image(2), true));
     assert_eq!(
@@ -136,7 +136,7 @@ fn the_scene_end_stops_the_device_at_its_instant_however_late_stop_comes() {
     host.images(&mut dev, 0, &images(0, 8), 0);
     host.start_scene(&mut dev, 5, 0);
     let out = poll(&mut dev, 20 * MS); // no Stop: the host's Stop is late
-    let flags: Vec<_> = served(&out).iter().map(|(k, s)| (*k, s.underrun)).collect();
+    let flags = underrun_flags(&out);
     assert_eq!(flags, (0..5).map(|k| (k, false)).collect::<Vec<_>>());
     let t = telemetry(&out).expect("a Telemetry when the device stops");
     assert_eq!(t.state, DeviceState::Stopped);
@@ -164,7 +164,7 @@ fn a_missing_last_sample_is_an_underrun_and_the_scene_still_ends() {
     host.images(&mut dev, 0, &images(0, 4), 0);
     host.start_scene(&mut dev, 5, 0);
     let out = poll(&mut dev, 20 * MS);
-    let flags: Vec<_> = served(&out).iter().map(|(k, s)| (*k, s.underrun)).collect();
+    let flags = underrun_flags(&out);
     assert_eq!(flags, (0..5).map(|k| (k, k == 4)).collect::<Vec<_>>());
     let t = telemetry(&out).unwrap();
     assert_eq!(

@@ -184,18 +184,19 @@ impl ClockFit {
 /// however many and however clustered in time, move it only where they are the lowest pairs.
 /// `None` with fewer than two distinct device times (non-finite pairs are ignored).
 pub fn fit_clock(pairs: &[(f64, f64)]) -> Option<ClockFit> {
-    let mut points: Vec<(f64, f64)> = pairs
+    let finite: Vec<(f64, f64)> = pairs
         .iter()
         .copied()
         .filter(|p| p.0.is_finite() && p.1.is_finite())
         .collect();
+    let mut points = finite.clone();
     points.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     points.dedup_by(|later, first| later.0 == first.0); // the earliest arrival of a device time
     let hull = lower_hull(&points);
     if hull.len() < 2 {
         return None;
     }
-    let n = pairs.len() as f64;
+    let n = finite.len() as f64;
     let mean_d = points.iter().map(|p| p.0).sum::<f64>() / points.len() as f64;
     let edge = hull
         .windows(2)
@@ -209,9 +210,9 @@ pub fn fit_clock(pairs: &[(f64, f64)]) -> Option<ClockFit> {
         drift_ppm: (rate / 1000.0 - 1.0) * 1e6,
         residual_rms_ns: 0.0,
         residual_max_ns: 0.0,
-        points: pairs.len(),
+        points: finite.len(),
     };
-    let residuals = pairs.iter().map(|p| p.1 - fit.host_ns(p.0));
+    let residuals = finite.iter().map(|p| p.1 - fit.host_ns(p.0));
     let sum_sq: f64 = residuals.clone().map(|r| r * r).sum();
     Some(ClockFit {
         residual_rms_ns: (sum_sq / n).sqrt(),
@@ -263,6 +264,11 @@ mod tests {
         assert!(fit_clock(&[(1.0, 2.0), (1.0, 3.0)]).is_none());
         assert!(fit_clock(&[(1.0, 2.0), (f64::NAN, 3.0), (2.0, f64::INFINITY)]).is_none());
         assert!(fit_clock(&[]).is_none());
+        let mut with_nan = pairs.clone();
+        with_nan.push((f64::NAN, 1.0));
+        let fit = fit_clock(&with_nan).unwrap();
+        assert_eq!(fit.points, pairs.len(), "the non-finite pair is left out");
+        assert!(fit.residual_max_ns < 1e-3, "{fit:?}");
     }
 
     #[test]

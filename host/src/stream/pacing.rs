@@ -103,8 +103,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             self.write_batch(n, None, false)?;
         }
         // The device serves samples 0..total and stops by itself at the scene's end.
-        let total_samples = self.total();
-        self.send(&Message::Start(Start::scene(0, total_samples)))?;
+        self.send(&Message::Start(Start::scene(0, self.total())))?;
         let start = Instant::now();
         self.start = Some(start);
         let start_ns = self.host_ns(start);

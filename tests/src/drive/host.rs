@@ -77,8 +77,7 @@ impl Host {
             next += n;
             batches += 1;
         }
-        let outputs = script.outputs;
-        self.send(&Message::Start(Start::scene(0, outputs)))?;
+        self.send(&Message::Start(Start::scene(0, script.outputs)))?;
         let start = Instant::now();
         let mut lateness_ns = Vec::new();
         let mut credit_stalls = 0u64;
