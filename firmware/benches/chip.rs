@@ -13,8 +13,8 @@
 #![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use margemu_firmware::chip::{Mpu9250, PhysicalSample, SpiTarget};
-use margemu_protocol::regmap::image::{ImageConfig, ImageRepr};
+use margemu_firmware::chip::{Mpu6xxx, PhysicalSample, SpiTarget};
+use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
 use std::hint::black_box;
 
 const BURST: usize = 22;
@@ -31,9 +31,9 @@ fn sample() -> PhysicalSample {
 /// A chip set up like the `mpu9250` crate's MARG mode over SPI: AK8963 at 100 Hz 16-bit,
 /// slave 0 reading its 7 data bytes each sample, FIFO on with accel + temp + gyro, data ready
 /// interrupt latched.
-fn marg_chip() -> Mpu9250 {
-    let mut chip = Mpu9250::new();
-    let write = |chip: &mut Mpu9250, bytes: &[u8]| {
+fn marg_chip() -> Mpu6xxx {
+    let mut chip = Mpu6xxx::new();
+    let write = |chip: &mut Mpu6xxx, bytes: &[u8]| {
         chip.select();
         for &b in bytes {
             chip.exchange(b);

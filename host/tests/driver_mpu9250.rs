@@ -44,12 +44,12 @@ use margemu::bus::{self, Clock, Shared};
 use margemu::marg::MargSim;
 use margemu::run::collect;
 use margemu::scene::Scene;
-use margemu_firmware::chip::{Mpu9250 as Chip, PhysicalSample};
+use margemu_firmware::chip::{Mpu6xxx as Chip, PhysicalSample};
 use margemu_protocol::regmap::ak8963::MagBits;
-use margemu_protocol::regmap::convert::{
+use margemu_protocol::regmap::mpu6xxx::convert::{
     asa_factor, mag_axes_from_mpu, temp_to_raw, STANDARD_GRAVITY, TEMP_LSB_PER_C, TEMP_OFFSET_C,
 };
-use margemu_protocol::regmap::mpu9250::{AccelFs, GyroFs};
+use margemu_protocol::regmap::mpu6xxx::{AccelFs, GyroFs};
 use mpu9250::{
     AccelDataRate, AccelScale, Dlpf, GyroScale, GyroTempDataRate, MagScale, Marg, MpuConfig,
 };

@@ -11,10 +11,10 @@
 
 use margemu::scene::Scene;
 use margemu::stream::{predict_model, rate_of, ImageSettings, StreamError, WHO_AM_I};
-use margemu_firmware::chip::Mpu9250;
+use margemu_firmware::chip::Mpu6xxx;
 use margemu_model::sensor::Truth;
 use margemu_protocol::link::{Configure, Image, ModelParams, Rate, Source, CRC32C};
-use margemu_protocol::regmap::image::ImageConfig;
+use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
 
 /// One scene prepared for source mode (b).
 #[derive(Clone, Debug)]
@@ -68,7 +68,7 @@ impl ModelStream {
             params: prediction.params,
             kinematics: prediction.kinematics,
             images: prediction.samples.into_iter().map(|s| s.image).collect(),
-            image_config: Mpu9250::new().image_config(),
+            image_config: Mpu6xxx::new().image_config(),
         })
     }
 

@@ -34,7 +34,7 @@
 //! ```
 
 use margemu_protocol::regmap::ak8963::{self as map, bits, reg, MagBits, Mode};
-use margemu_protocol::regmap::convert::{mag_measurement, mag_self_test};
+use margemu_protocol::regmap::mpu6xxx::convert::{mag_measurement, mag_self_test};
 
 use super::I2cTarget;
 

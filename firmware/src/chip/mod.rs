@@ -17,18 +17,18 @@
 //! acknowledge its address ignores the following bytes until the next START.
 //!
 //! Chips:
-//! - [`Mpu9250`]: the InvenSense MPU-9250 (and its WHO_AM_I variants) with the [`Ak8963`]
+//! - [`Mpu6xxx`]: the InvenSense 6xxx family (the MPU-9250 and its WHO_AM_I variants) with the [`Ak8963`]
 //!   magnetometer behind its auxiliary I2C master or in bypass mode;
 //! - [`Ak8963`] on its own, as an [`I2cTarget`].
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
 mod ak8963;
-pub mod mpu9250;
+pub mod mpu6xxx;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
-pub use mpu9250::{Config, Mpu9250, Variant};
+pub use mpu6xxx::{Config, Mpu6xxx, Variant};
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 
 /// The SPI target side of a chip (mode 0/3, MSB first), byte by byte.

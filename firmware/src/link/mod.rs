@@ -82,7 +82,7 @@ use margemu_protocol::link::{
 use margemu_protocol::link::{ServedBatch, ServedSample, CRC32C};
 use margemu_protocol::PROTOCOL_VERSION;
 
-use crate::chip::{self, Mpu9250};
+use crate::chip::{self, Mpu6xxx};
 use setup::Model;
 
 /// Telemetry period when Configure asks for the default (0): 100 ms.
@@ -168,7 +168,7 @@ pub struct Device<const N: usize = 128> {
 }
 
 struct Core<const N: usize> {
-    chip: Mpu9250,
+    chip: Mpu6xxx,
     identity: Identity,
     state: DeviceState,
     session: Option<Session>,
@@ -215,7 +215,7 @@ impl<const N: usize> Device<N> {
         Self {
             rx: Accumulator::new(),
             core: Core {
-                chip: Mpu9250::new(),
+                chip: Mpu6xxx::new(),
                 identity,
                 state: DeviceState::Idle,
                 session: None,
@@ -264,12 +264,12 @@ impl<const N: usize> Device<N> {
     }
 
     /// The emulated chip, for the board's (or the host's) SPI/I2C target.
-    pub fn chip_mut(&mut self) -> &mut Mpu9250 {
+    pub fn chip_mut(&mut self) -> &mut Mpu6xxx {
         &mut self.core.chip
     }
 
     /// The emulated chip.
-    pub fn chip(&self) -> &Mpu9250 {
+    pub fn chip(&self) -> &Mpu6xxx {
         &self.core.chip
     }
 

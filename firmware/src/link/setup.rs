@@ -5,10 +5,10 @@ use margemu_model::sensor::{Marg, Truth};
 use margemu_protocol::link::{
     Chips, Configure, ErrorCode, ModelParams, Rate, RegisterFile, RegisterOverride, Source,
 };
-use margemu_protocol::regmap::convert::TEMP_OFFSET_C;
-use margemu_protocol::regmap::image::{ImageRepr, IMAGE_LEN};
+use margemu_protocol::regmap::mpu6xxx::convert::TEMP_OFFSET_C;
+use margemu_protocol::regmap::mpu6xxx::image::{ImageRepr, IMAGE_LEN};
 
-use crate::chip::{Config, I2cTarget, Mpu9250, SpiTarget, Variant};
+use crate::chip::{Config, I2cTarget, Mpu6xxx, SpiTarget, Variant};
 
 /// The chips this device emulates.
 pub const CHIPS: Chips =
@@ -32,7 +32,7 @@ const BYPASS_EN: u8 = 0x02;
 const I2C_MST_EN: u8 = 0x20;
 const AK8963_ADDRESS: u8 = 0x0C;
 
-fn spi_write(chip: &mut Mpu9250, register: u8, value: u8) {
+fn spi_write(chip: &mut Mpu6xxx, register: u8, value: u8) {
     chip.select();
     chip.exchange(register & 0x7F);
     chip.exchange(value);
@@ -42,7 +42,7 @@ fn spi_write(chip: &mut Mpu9250, register: u8, value: u8) {
 /// Applies one override through the chip's own bus targets (SPI for the MPU-9250; the AK8963
 /// through I2C bypass, INT_PIN_CFG and USER_CTRL restored afterwards). The writes land in the
 /// write log; the caller empties it.
-fn apply_override(chip: &mut Mpu9250, o: &RegisterOverride) {
+fn apply_override(chip: &mut Mpu6xxx, o: &RegisterOverride) {
     match o.file {
         RegisterFile::Mpu9250 => spi_write(chip, o.register, o.value),
         RegisterFile::Ak8963 => {
@@ -65,9 +65,9 @@ fn apply_override(chip: &mut Mpu9250, o: &RegisterOverride) {
 }
 
 /// A fresh chip of `cfg`'s variant with its overrides applied and its write log emptied.
-pub fn build_chip(cfg: &Configure) -> Result<Mpu9250, ErrorCode> {
+pub fn build_chip(cfg: &Configure) -> Result<Mpu6xxx, ErrorCode> {
     let variant = variant(cfg.who_am_i).ok_or(ErrorCode::UnsupportedChip)?;
-    let mut chip = Mpu9250::with_config(Config {
+    let mut chip = Mpu6xxx::with_config(Config {
         variant,
         ..Config::default()
     });
@@ -118,7 +118,7 @@ impl Model {
 
     /// One output sample from the held kinematics, as the register image the chip serves
     /// (`None` before the first kinematics sample: the model does not step).
-    pub fn image(&mut self, chip: &Mpu9250) -> Option<[u8; IMAGE_LEN]> {
+    pub fn image(&mut self, chip: &Mpu6xxx) -> Option<[u8; IMAGE_LEN]> {
         let truth = self.held?;
         Some(model_image(
             &mut self.marg,
@@ -141,12 +141,12 @@ pub fn truth_index_at(rate: Rate, t_ns: u64) -> u64 {
 /// The image of one model step, exactly as the device computes it in source mode (b), so a
 /// host can predict it: the model's sample, the field scaled to µT as
 /// `(f64::from(mag) * mag_ut_per_unit) as f32`, the temperature of the kinematics (21 °C, TEMP_OUT
-/// 0, when absent), converted with the chip's current [`Mpu9250::image_config`].
+/// 0, when absent), converted with the chip's current [`Mpu6xxx::image_config`].
 pub fn model_image(
     marg: &mut Marg,
     truth: &Truth,
     mag_ut_per_unit: f64,
-    chip: &Mpu9250,
+    chip: &Mpu6xxx,
 ) -> [u8; IMAGE_LEN] {
     let s = marg.sample(truth);
     let mag = s.mag.map(|m| (f64::from(m) * mag_ut_per_unit) as f32);

@@ -11,7 +11,7 @@
 //! not wait for.
 //!
 //! **The design.** The main loop, which owns the chip, keeps a [`Shadow`]: every register as a
-//! bus read would see it ([`Mpu9250::peek`]), and the MISO stream of the burst read the
+//! bus read would see it ([`Mpu6xxx::peek`]), and the MISO stream of the burst read the
 //! controller most likely makes next (from [`Speculator::start`], by default ACCEL_XOUT_H, where
 //! flight-controller drivers start their sensor burst). The board preloads that stream into its
 //! TX DMA while chip select is high, so the predicted burst is served by hardware at any clock.
@@ -33,9 +33,9 @@
 //! the same [`serve`] through a simulated port clocked at chosen speeds.
 //!
 //! ```
-//! use margemu_firmware::chip::Mpu9250;
+//! use margemu_firmware::chip::Mpu6xxx;
 //! use margemu_firmware::spi_shadow::{replay, Capture, Outcome, Shadow, DEFAULT_START};
-//! let mut chip = Mpu9250::new();
+//! let mut chip = Mpu6xxx::new();
 //! let mut shadow = Shadow::new();
 //! shadow.capture(&chip, DEFAULT_START, 0);
 //! assert_eq!(shadow.read(0x75), 0x71); // WHO_AM_I, as a bus read would return it
@@ -55,9 +55,9 @@ mod tests;
 pub use serve::{serve, Capture, SpiPort};
 pub use verify::{replay, Outcome, Speculator, Stats, SWITCH_AFTER};
 
-use margemu_protocol::regmap::mpu9250::{is_read_only, next_address, reg, write_mask};
+use margemu_protocol::regmap::mpu6xxx::{is_read_only, next_address, reg, write_mask};
 
-use crate::chip::Mpu9250;
+use crate::chip::Mpu6xxx;
 
 /// MISO bytes the preloaded stream covers, and MOSI bytes a [`Capture`] keeps: the address
 /// byte and 128 data bytes (every register once).
@@ -117,7 +117,7 @@ impl Shadow {
 
     /// Takes every register of `chip` (without read side effects) and builds the stream of a
     /// burst read from `start`; `generation` numbers the chip state it was taken from.
-    pub fn capture(&mut self, chip: &Mpu9250, start: u8, generation: u32) {
+    pub fn capture(&mut self, chip: &Mpu6xxx, start: u8, generation: u32) {
         for (addr, slot) in (0u8..).zip(self.regs.iter_mut()) {
             *slot = chip.peek(addr);
         }

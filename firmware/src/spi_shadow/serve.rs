@@ -1,7 +1,7 @@
 //! The board's highest-priority SPI handler: [`serve`] one transaction from the [`Shadow`]
 //! through an [`SpiPort`], recording it as a [`Capture`].
 
-use margemu_protocol::regmap::mpu9250::next_address;
+use margemu_protocol::regmap::mpu6xxx::next_address;
 
 use super::{burst_address, Shadow, STREAM_LEN};
 

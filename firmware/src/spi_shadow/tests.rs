@@ -1,15 +1,15 @@
-use margemu_protocol::regmap::image::IMAGE_LEN;
-use margemu_protocol::regmap::mpu9250::{is_read_only, reg};
+use margemu_protocol::regmap::mpu6xxx::image::IMAGE_LEN;
+use margemu_protocol::regmap::mpu6xxx::{is_read_only, reg};
 
 use super::sim::{SimPort, Timing, FAST, SLOW, UNDERRUN};
 use super::*;
-use crate::chip::{Mpu9250, SpiTarget};
+use crate::chip::{Mpu6xxx, SpiTarget};
 
 const READ: u8 = 0x80;
 
 /// A chip with a recognisable sample latched (every image byte distinct and non-zero).
-fn chip_with_sample() -> Mpu9250 {
-    let mut chip = Mpu9250::new();
+fn chip_with_sample() -> Mpu6xxx {
+    let mut chip = Mpu6xxx::new();
     let image: [u8; IMAGE_LEN] = core::array::from_fn(|i| 0x11 + i as u8 * 7);
     chip.latch_image_at(&image, 1_000_000);
     chip
@@ -17,7 +17,7 @@ fn chip_with_sample() -> Mpu9250 {
 
 /// What the chip itself puts on MISO for `mosi` (one byte ahead, as `SpiTarget` specifies),
 /// on a copy so the chip is left as it was.
-fn reference(chip: &Mpu9250, mosi: &[u8]) -> [u8; 256] {
+fn reference(chip: &Mpu6xxx, mosi: &[u8]) -> [u8; 256] {
     let mut chip = chip.clone();
     let mut miso = [0; 256];
     let mut next = chip.select();

@@ -1,10 +1,10 @@
 //! Source (b): kinematics in, the shared model on the device, images bit-identical to the
 //! host's own `Marg` + `ImageRepr::from_physical`.
 
-use margemu_firmware::chip::Mpu9250;
+use margemu_firmware::chip::Mpu6xxx;
 use margemu_model::sensor::{Marg, MargConfig, Truth};
 use margemu_protocol::link::{Configure, KinematicsBatch, Message, ModelParams, Rate, Source};
-use margemu_protocol::regmap::image::ImageRepr;
+use margemu_protocol::regmap::mpu6xxx::image::ImageRepr;
 
 use crate::common::*;
 
@@ -59,7 +59,7 @@ fn model_images_equal_the_hosts_prediction_bit_for_bit() {
 
     // The host's prediction, computed independently of the device's code.
     let mut marg = Marg::new(&marg_config(), 1000.0, SEED).unwrap();
-    let cfg = Mpu9250::new().image_config();
+    let cfg = Mpu6xxx::new().image_config();
     for k in 0..220u64 {
         poll(&mut dev, k * MS);
         let j = (k / 5).min(39); // 200 Hz truth held over 5 outputs; 39 is the last sent

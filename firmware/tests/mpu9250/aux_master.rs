@@ -5,7 +5,7 @@ use super::*;
 
 /// Slave 4 transfer as the `mpu9250` crate does it over SPI: ADDR, REG, (DO), CTRL = 0x80,
 /// then poll I2C_MST_STATUS for SLV4_DONE. Returns I2C_SLV4_DI.
-fn slv4(c: &mut Mpu9250, addr: u8, reg: u8, value: Option<u8>) -> u8 {
+fn slv4(c: &mut Mpu6xxx, addr: u8, reg: u8, value: Option<u8>) -> u8 {
     match value {
         Some(v) => spi_write(c, 0x31, &[addr, reg, v, 0x80]),
         None => spi_write(c, 0x31, &[addr, reg]),
@@ -26,14 +26,14 @@ fn slv4(c: &mut Mpu9250, addr: u8, reg: u8, value: Option<u8>) -> u8 {
     spi_read(c, 0x35, 1)[0]
 }
 
-fn spi_mode_master(c: &mut Mpu9250) {
+fn spi_mode_master(c: &mut Mpu6xxx) {
     spi_write(c, 0x6A, &[0x32]); // I2C_MST_EN | I2C_IF_DIS | I2C_MST_RST
     assert_eq!(spi_read(c, 0x6A, 1), [0x30]);
 }
 
 #[test]
 fn slave_4_reads_and_writes_the_ak8963() {
-    let mut c = Mpu9250::with_config(Config {
+    let mut c = Mpu6xxx::with_config(Config {
         asa: [0xB0, 0xB1, 0xB2],
         ..Config::default()
     });

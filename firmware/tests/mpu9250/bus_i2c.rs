@@ -8,7 +8,7 @@ fn address_0x68_and_0x69_with_ad0() {
     let mut low = chip();
     assert_eq!(i2c_read(&mut low, 0x68, 0x75, 1), Some(vec![0x71]));
     assert_eq!(i2c_read(&mut low, 0x69, 0x75, 1), None);
-    let mut high = Mpu9250::with_config(Config {
+    let mut high = Mpu6xxx::with_config(Config {
         ad0: true,
         ..Config::default()
     });
@@ -83,7 +83,7 @@ fn bypass_exposes_the_ak8963_only_with_the_master_off() {
 
 #[test]
 fn no_bypass_on_a_part_without_magnetometer() {
-    let mut c = Mpu9250::with_config(Config {
+    let mut c = Mpu6xxx::with_config(Config {
         variant: margemu_firmware::chip::Variant::Mpu6500,
         ..Config::default()
     });

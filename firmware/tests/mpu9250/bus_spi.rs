@@ -11,7 +11,7 @@ fn who_am_i_of_each_variant() {
         (Variant::Mpu6500, 0x70),
         (Variant::WhoAmI68, 0x68),
     ] {
-        let mut chip = Mpu9250::with_config(Config {
+        let mut chip = Mpu6xxx::with_config(Config {
             variant,
             ..Config::default()
         });

@@ -3,7 +3,7 @@
 //! 4.22–4.24, 4.39).
 
 use super::*;
-use margemu_protocol::regmap::image::{ImageConfig, ImageRepr};
+use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
 
 const G: f32 = 9.80665;
 const DPS: f32 = core::f32::consts::PI / 180.0;
@@ -178,11 +178,11 @@ fn image_config_tracks_the_registers() {
     let cfg = c.image_config();
     assert_eq!(
         cfg.gyro_fs,
-        margemu_protocol::regmap::mpu9250::GyroFs::Dps1000
+        margemu_protocol::regmap::mpu6xxx::GyroFs::Dps1000
     );
     assert_eq!(
         cfg.accel_fs,
-        margemu_protocol::regmap::mpu9250::AccelFs::G16
+        margemu_protocol::regmap::mpu6xxx::AccelFs::G16
     );
     assert_eq!(
         cfg,
@@ -211,7 +211,7 @@ fn latch_without_a_time_steps_the_chip_sample_clock() {
 
 #[test]
 fn user_offset_registers_shift_the_output() {
-    let mut c = Mpu9250::with_config(Config {
+    let mut c = Mpu6xxx::with_config(Config {
         accel_offset: [0x1000, 0x0000, 0xFFFE],
         ..Config::default()
     });

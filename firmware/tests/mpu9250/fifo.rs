@@ -15,12 +15,12 @@ fn sample(n: i16) -> PhysicalSample {
     }
 }
 
-fn count(c: &mut Mpu9250) -> u16 {
+fn count(c: &mut Mpu6xxx) -> u16 {
     let b = spi_read(c, 0x72, 2);
     u16::from_be_bytes([b[0], b[1]])
 }
 
-fn enable(c: &mut Mpu9250, fifo_en: u8) {
+fn enable(c: &mut Mpu6xxx, fifo_en: u8) {
     spi_write(c, 0x23, &[fifo_en]);
     spi_write(c, 0x6A, &[0x40]);
 }

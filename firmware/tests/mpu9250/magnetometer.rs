@@ -6,8 +6,8 @@ use super::*;
 
 const AK: u8 = 0x0C;
 
-fn bypass(asa: [u8; 3]) -> Mpu9250 {
-    let mut c = Mpu9250::with_config(Config {
+fn bypass(asa: [u8; 3]) -> Mpu6xxx {
+    let mut c = Mpu6xxx::with_config(Config {
         asa,
         ..Config::default()
     });
@@ -20,7 +20,7 @@ fn field(mag: [f32; 3]) -> PhysicalSample {
 }
 
 /// ST1, HXL..HZH, ST2 in one read, as drivers do.
-fn read_st1_to_st2(c: &mut Mpu9250) -> Vec<u8> {
+fn read_st1_to_st2(c: &mut Mpu6xxx) -> Vec<u8> {
     i2c_read(c, AK, 0x02, 8).expect("AK8963 acknowledges")
 }
 
@@ -208,7 +208,7 @@ fn self_test_procedure() {
 
 #[test]
 fn register_images_feed_the_magnetometer_on_its_own_schedule() {
-    use margemu_protocol::regmap::image::{ImageConfig, ImageRepr};
+    use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
     let mut c = bypass([128; 3]);
     i2c_write(&mut c, AK, &[0x0A, 0x16]);
     let cfg = ImageConfig {

@@ -17,13 +17,13 @@ mod random_sequences;
 mod resets;
 mod write_log;
 
-use margemu_firmware::chip::{Config, I2cTarget, Mpu9250, PhysicalSample, SpiTarget};
+use margemu_firmware::chip::{Config, I2cTarget, Mpu6xxx, PhysicalSample, SpiTarget};
 
 pub const MS: u64 = 1_000_000;
 
 /// A fresh MPU-9250 with nominal fuse ROM values (ASA 128: adjustment factor 1).
-pub fn chip() -> Mpu9250 {
-    Mpu9250::with_config(Config {
+pub fn chip() -> Mpu6xxx {
+    Mpu6xxx::with_config(Config {
         asa: [128; 3],
         ..Config::default()
     })
@@ -94,6 +94,6 @@ pub fn at_rest() -> PhysicalSample {
 }
 
 /// Every MPU-9250 register as the bus would read it, without side effects.
-pub fn registers(chip: &Mpu9250) -> Vec<u8> {
+pub fn registers(chip: &Mpu6xxx) -> Vec<u8> {
     (0..0x80).map(|a| chip.peek(a)).collect()
 }

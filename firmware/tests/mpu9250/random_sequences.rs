@@ -90,7 +90,7 @@ fn variant() -> impl Strategy<Value = Variant> {
     ])
 }
 
-fn run(c: &mut Mpu9250, ops: &[Op]) -> u64 {
+fn run(c: &mut Mpu6xxx, ops: &[Op]) -> u64 {
     let mut now = 0u64;
     for op in ops {
         match op {
@@ -137,14 +137,14 @@ fn run(c: &mut Mpu9250, ops: &[Op]) -> u64 {
     now
 }
 
-fn ak_registers(c: &Mpu9250) -> Vec<u8> {
+fn ak_registers(c: &Mpu6xxx) -> Vec<u8> {
     c.ak8963()
         .map(|ak| (0..0x20).map(|a| ak.peek(a)).collect())
         .unwrap_or_default()
 }
 
 /// After the sequence: end any transaction, then H_RESET over SPI and SRST in bypass mode.
-fn recover(c: &mut Mpu9250) {
+fn recover(c: &mut Mpu6xxx) {
     c.deselect();
     c.stop();
     spi_write(c, 0x6B, &[0x80]);
@@ -154,7 +154,7 @@ fn recover(c: &mut Mpu9250) {
 }
 
 /// The recovered chip must behave like a fresh one: same sample, same bytes.
-fn serves_like_new(c: &mut Mpu9250, fresh: &mut Mpu9250, now: u64) {
+fn serves_like_new(c: &mut Mpu6xxx, fresh: &mut Mpu6xxx, now: u64) {
     for chip in [&mut *c, &mut *fresh] {
         spi_write(chip, 0x1C, &[0x08]);
         spi_write(chip, 0x6A, &[0x40]);
@@ -175,10 +175,10 @@ proptest! {
         ops in prop::collection::vec(op(), 0..200),
     ) {
         let config = Config { variant, ad0, ..Config::default() };
-        let mut c = Mpu9250::with_config(config);
+        let mut c = Mpu6xxx::with_config(config);
         let now = run(&mut c, &ops);
         recover(&mut c);
-        let mut fresh = Mpu9250::with_config(config);
+        let mut fresh = Mpu6xxx::with_config(config);
         prop_assert_eq!(registers(&c), registers(&fresh));
         prop_assert_eq!(ak_registers(&c), ak_registers(&fresh));
         serves_like_new(&mut c, &mut fresh, now);
@@ -186,12 +186,12 @@ proptest! {
 
     #[test]
     fn power_cycle_recovers_everything(ops in prop::collection::vec(op(), 0..200)) {
-        let mut c = Mpu9250::new();
+        let mut c = Mpu6xxx::new();
         let now = run(&mut c, &ops);
         c.deselect();
         c.stop();
         c.power_cycle();
-        let mut fresh = Mpu9250::new();
+        let mut fresh = Mpu6xxx::new();
         prop_assert_eq!(registers(&c), registers(&fresh));
         prop_assert_eq!(ak_registers(&c), ak_registers(&fresh));
         serves_like_new(&mut c, &mut fresh, now);

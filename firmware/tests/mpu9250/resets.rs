@@ -5,7 +5,7 @@ use super::*;
 
 #[test]
 fn reset_values_after_power_on() {
-    let c = Mpu9250::with_config(Config {
+    let c = Mpu6xxx::with_config(Config {
         self_test: [1, 2, 3, 4, 5, 6],
         accel_offset: [0x1234, 0x5678, 0x9ABC],
         ..Config::default()

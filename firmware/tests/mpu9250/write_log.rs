@@ -3,7 +3,7 @@
 use super::*;
 use margemu_firmware::chip::{Bus, RegisterWrite};
 
-fn drain(c: &mut Mpu9250) -> Vec<RegisterWrite> {
+fn drain(c: &mut Mpu6xxx) -> Vec<RegisterWrite> {
     core::iter::from_fn(|| c.pop_write()).collect()
 }
 
@@ -44,7 +44,7 @@ fn spi_i2c_bypass_and_aux_writes_are_logged() {
 
 #[test]
 fn the_log_keeps_the_newest_when_not_drained() {
-    let mut c = Mpu9250::with_config(Config {
+    let mut c = Mpu6xxx::with_config(Config {
         ad0: true,
         ..Config::default()
     });

@@ -15,9 +15,9 @@ use crate::csv_column::ColumnError;
 use crate::csv_table::Table;
 use margemu_protocol::link::IMAGE_LEN;
 use margemu_protocol::regmap::ak8963::MagBits;
-use margemu_protocol::regmap::convert::{asa_factor, STANDARD_GRAVITY};
-use margemu_protocol::regmap::image::{ImageConfig, ImageRepr};
-use margemu_protocol::regmap::mpu9250::AccelFs;
+use margemu_protocol::regmap::mpu6xxx::convert::{asa_factor, STANDARD_GRAVITY};
+use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
+use margemu_protocol::regmap::mpu6xxx::AccelFs;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -201,7 +201,7 @@ pub fn read_sent(path: &Path, meta: &SessionMeta) -> Result<super::input::Imu, C
 #[cfg(test)]
 mod tests {
     use super::*;
-    use margemu_protocol::regmap::mpu9250::GyroFs;
+    use margemu_protocol::regmap::mpu6xxx::GyroFs;
 
     #[test]
     fn decode_inverts_the_image_conversion_to_within_one_lsb() {

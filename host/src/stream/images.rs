@@ -23,7 +23,7 @@ use crate::marg::MargSim;
 use crate::scene::{FieldUnit, Scene};
 use crate::truth::Truth;
 use margemu_protocol::link::Image;
-use margemu_protocol::regmap::image::{ImageConfig, ImageRepr};
+use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
 
 /// µT per normalized field unit ("nu") unless told otherwise: the author's reference field has
 /// about unit norm, and 50 µT is a typical geomagnetic magnitude.
@@ -60,7 +60,7 @@ impl ImageSettings {
 /// ±250 °/s, AK8963 14-bit, the AK8963's fuse ROM sensitivity adjustment (ASA, so a driver that
 /// applies it reads the true field), no offsets.
 pub fn chip_power_on() -> ImageConfig {
-    margemu_firmware::chip::Mpu9250::new().image_config()
+    margemu_firmware::chip::Mpu6xxx::new().image_config()
 }
 
 /// One output sample: its truth and the register image the device should serve for it.

@@ -32,7 +32,7 @@
 //! ([`log`], written by their own thread) are flushed and end with an `end` row in
 //! `events.csv`.
 //!
-//! [`ImageRepr::from_physical`]: margemu_protocol::regmap::image::ImageRepr::from_physical
+//! [`ImageRepr::from_physical`]: margemu_protocol::regmap::mpu6xxx::image::ImageRepr::from_physical
 
 mod flow;
 pub mod images;

@@ -45,8 +45,8 @@ use crate::scene::Scene;
 use crate::truth::Truth;
 use margemu_model::sensor::{self, Marg};
 use margemu_protocol::link::{Image, ModelParams, Rate};
-use margemu_protocol::regmap::convert::TEMP_OFFSET_C;
-use margemu_protocol::regmap::image::ImageRepr;
+use margemu_protocol::regmap::mpu6xxx::convert::TEMP_OFFSET_C;
+use margemu_protocol::regmap::mpu6xxx::image::ImageRepr;
 
 /// The kinematics rate when none is asked for: the output rate over the smallest whole
 /// `hold ≥ 2` that brings it to at most this.
@@ -201,7 +201,7 @@ mod tests {
 
     #[test]
     fn the_power_on_conversion_is_nominal_but_for_the_fuse_rom() {
-        use margemu_protocol::regmap::image::ImageConfig;
+        use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
         let c = chip_power_on();
         assert_eq!(ImageConfig { asa: [128; 3], ..c }, ImageConfig::NOMINAL);
         assert_ne!(c.asa, [128; 3], "the emulated AK8963 has real fuse values");

@@ -133,7 +133,7 @@ pub fn to_body(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use margemu_protocol::regmap::convert::mag_axes_from_mpu;
+    use margemu_protocol::regmap::mpu6xxx::convert::mag_axes_from_mpu;
 
     #[test]
     fn mpu9250_alignment_undoes_the_chips_axis_swap() {

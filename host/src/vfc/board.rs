@@ -23,10 +23,10 @@
 
 use crate::bus::{self, Shared};
 use embedded_hal_compat::ReverseCompat;
-use margemu_firmware::chip::Mpu9250 as Chip;
+use margemu_firmware::chip::Mpu6xxx as Chip;
 use margemu_protocol::regmap::ak8963::MagBits;
-use margemu_protocol::regmap::image::ImageConfig;
-use margemu_protocol::regmap::mpu9250::{AccelFs, GyroFs};
+use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
+use margemu_protocol::regmap::mpu6xxx::{AccelFs, GyroFs};
 use mpu9250::{
     AccelDataRate, AccelScale, Dlpf, GyroScale, GyroTempDataRate, InterruptConfig, InterruptEnable,
     MagScale, Marg, MargMeasurements, MpuConfig,

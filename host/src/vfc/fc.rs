@@ -33,7 +33,7 @@ use crate::loopback::Firmware;
 use crate::offline::ParamError;
 use margemu_filters::{AttitudeFilter, Diagnostics, Imu, Initial};
 use margemu_protocol::link::DeviceState;
-use margemu_protocol::regmap::image::ImageConfig;
+use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
 use mavlink::dialects::common::{
     MavAutopilot, MavMessage, MavModeFlag, MavState, MavType, HEARTBEAT_DATA,
 };

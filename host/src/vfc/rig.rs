@@ -17,7 +17,7 @@ use crate::dut::{DutConfig, DutError, DutProgress, DutProtocol, DutReader, DutSu
 use crate::loopback::{spawn_device_with_local, DeviceReport, LoopbackDevice};
 use crate::scene::Scene;
 use crate::stream::{Progress, Session, StreamConfig, StreamError, Summary};
-use margemu_protocol::regmap::image::ImageConfig;
+use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
 use serialport::{SerialPort, TTYPort};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};

@@ -20,9 +20,9 @@
 use core::sync::atomic::{AtomicBool, Ordering};
 
 use cortex_m::peripheral::NVIC;
-use margemu_firmware::chip::{I2cTarget, Mpu9250};
+use margemu_firmware::chip::{I2cTarget, Mpu6xxx};
 use margemu_firmware::protocol::regmap::ak8963;
-use margemu_firmware::protocol::regmap::mpu9250::{bits, reg};
+use margemu_firmware::protocol::regmap::mpu6xxx::{bits, reg};
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, I2C1};
 use stm32f4xx_hal::rcc::{Enable, Rcc, Reset};
 
@@ -72,7 +72,7 @@ pub fn init(_i2c: I2C1, rcc: &mut Rcc, pclk1_hz: u32) {
 /// Follows the chip's bus state: its address (AD0), whether the AK8963 answers (bypass), and
 /// whether the I2C interface is enabled at all (USER_CTRL.I2C_IF_DIS). Called with the device
 /// locked, so no transaction is being handled.
-pub fn configure(chip: &Mpu9250) {
+pub fn configure(chip: &Mpu6xxx) {
     let i2c = regs();
     let oar1 = OAR1_KEEP | u16::from(chip.i2c_address()) << 1;
     let mut oar2 = u16::from(ak8963::I2C_ADDRESS) << 1;
@@ -162,7 +162,7 @@ fn I2C1_ER() {
     }
 }
 
-fn end(chip: &mut Mpu9250) {
+fn end(chip: &mut Mpu6xxx) {
     chip.stop();
     let i2c = regs();
     i2c.cr2()

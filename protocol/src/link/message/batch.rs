@@ -26,8 +26,8 @@ use crate::link::wire::{Reader, Writer};
 use crate::link::{Error, MAX_PAYLOAD_LEN};
 
 /// Bytes of one register image: the MPU-9250 data registers and the AK8963 block, laid out
-/// by [`crate::regmap::image`] (the link carries it as opaque bytes).
-pub use crate::regmap::image::IMAGE_LEN;
+/// by [`crate::regmap::mpu6xxx::image`] (the link carries it as opaque bytes).
+pub use crate::regmap::mpu6xxx::image::IMAGE_LEN;
 
 /// One finished register image (see [`IMAGE_LEN`]).
 pub type Image = [u8; IMAGE_LEN];

@@ -10,9 +10,9 @@
 //! record can therefore be cut, which is why drivers reset the FIFO after an overflow). Reading
 //! FIFO_R_W when empty returns the last byte read (RM section 4.37).
 
-use margemu_protocol::regmap::mpu9250::{bits, reg, FIFO_SIZE, SENSOR_LEN};
+use margemu_protocol::regmap::mpu6xxx::{bits, reg, FIFO_SIZE, SENSOR_LEN};
 
-use super::Mpu9250;
+use super::Mpu6xxx;
 
 /// The FIFO storage: a byte ring.
 #[derive(Clone, Debug)]
@@ -83,7 +83,7 @@ impl Fifo {
     }
 }
 
-impl Mpu9250 {
+impl Mpu6xxx {
     /// Pushes `bytes` under the current CONFIG.FIFO_MODE; raises FIFO_OFLOW_INT on overflow.
     pub(super) fn fifo_push(&mut self, bytes: &[u8]) {
         let keep_old = self.regs[usize::from(reg::CONFIG)] & bits::CONFIG_FIFO_MODE != 0;

@@ -9,13 +9,13 @@
 //!    reads into EXT_SENS_DATA, the FIFO record, INT_STATUS.RAW_DATA_RDY_INT (set whether or not
 //!    it is enabled, so polling drivers see it; the pin follows INT_ENABLE), and the swap.
 
-use margemu_protocol::regmap::image::{field, ImageRepr, IMAGE_LEN};
-use margemu_protocol::regmap::mpu9250::{bits, DATA_LEN, SENSOR_LEN};
+use margemu_protocol::regmap::mpu6xxx::image::{field, ImageRepr, IMAGE_LEN};
+use margemu_protocol::regmap::mpu6xxx::{bits, DATA_LEN, SENSOR_LEN};
 
 use super::super::{MagSource, PhysicalSample};
-use super::Mpu9250;
+use super::Mpu6xxx;
 
-impl Mpu9250 {
+impl Mpu6xxx {
     pub(super) fn latch_physical(&mut self, sample: &PhysicalSample, now_ns: u64) {
         let cfg = self.image_config();
         let repr = ImageRepr::from_physical(sample.acc, sample.gyr, sample.temp_c, [0.0; 3], &cfg);
@@ -67,7 +67,7 @@ impl Mpu9250 {
 mod tests {
     use super::super::Config;
     use super::*;
-    use margemu_protocol::regmap::image::ImageConfig;
+    use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
 
     #[test]
     fn physical_and_image_paths_give_the_same_registers() {
@@ -77,8 +77,8 @@ mod tests {
             mag: [20.0, -5.0, 40.0],
             temp_c: 30.5,
         };
-        let mut a = Mpu9250::new();
-        let mut b = Mpu9250::new();
+        let mut a = Mpu6xxx::new();
+        let mut b = Mpu6xxx::new();
         a.latch_at(&sample, 1_000);
         let cfg = ImageConfig {
             asa: Config::default().asa,

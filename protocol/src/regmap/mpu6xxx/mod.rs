@@ -1,17 +1,20 @@
-//! The MPU-9250 accel/gyro die: register addresses, bits, reset values, access masks, full
+//! The InvenSense 6xxx family (MPU-9250 and its variants), accel/gyro die: register addresses, bits, reset values, access masks, full
 //! scales and the output-rate rule (InvenSense RM-MPU-9250A-00 rev. 1.6, "RM" below).
 //!
 //! Everything here is data about the silicon; the behaviour that uses it lives in
 //! `margemu_firmware::chip`. The host uses the same tables to predict what a driver reads.
 //!
 //! ```
-//! use margemu_protocol::regmap::mpu9250::{reg, sample_period_ns, reset_value, GyroFs};
+//! use margemu_protocol::regmap::mpu6xxx::{reg, sample_period_ns, reset_value, GyroFs};
 //! assert_eq!(reset_value(reg::PWR_MGMT_1), 0x01);
 //! assert_eq!(reset_value(reg::WHO_AM_I), 0x71);
 //! // DLPF on (DLPF_CFG = 1), SMPLRT_DIV = 4: 1 kHz / 5 = 200 Hz.
 //! assert_eq!(sample_period_ns(0x01, 0x00, 4), 5_000_000);
 //! assert_eq!(GyroFs::from_gyro_config(0x18), GyroFs::Dps2000);
 //! ```
+
+pub mod convert;
+pub mod image;
 
 /// Register addresses (RM section 3, table 1).
 pub mod reg {

@@ -8,10 +8,10 @@
 //! appears at STOP.
 
 use margemu_protocol::regmap::ak8963::I2C_ADDRESS as AK_ADDRESS;
-use margemu_protocol::regmap::mpu9250::{bits, next_address, reg};
+use margemu_protocol::regmap::mpu6xxx::{bits, next_address, reg};
 
 use super::super::{Bus, I2cTarget};
-use super::Mpu9250;
+use super::Mpu6xxx;
 
 /// Which die the current I2C transaction addresses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -40,7 +40,7 @@ impl I2cState {
     }
 }
 
-impl I2cTarget for Mpu9250 {
+impl I2cTarget for Mpu6xxx {
     fn start(&mut self, address: u8, read: bool) -> bool {
         self.i2c.active = true;
         let if_disabled = self.regs[usize::from(reg::USER_CTRL)] & bits::USER_I2C_IF_DIS != 0;
@@ -105,7 +105,7 @@ impl I2cTarget for Mpu9250 {
     }
 }
 
-impl Mpu9250 {
+impl Mpu6xxx {
     fn ak_bypass_write(&mut self, byte: u8) -> bool {
         let Some(ak) = &mut self.ak else { return false };
         let pointer = ak.pointer();

@@ -2,21 +2,21 @@
 //! what a write stores and triggers (RM-MPU-9250A-00 section 4).
 //!
 //! A bus read is split in two so the SPI target can prefetch one byte ahead:
-//! [`Mpu9250::read_register`] returns the value (and may latch FIFO_COUNT, which is harmless if
-//! the byte is never clocked out); [`Mpu9250::commit_read`] applies what clocking the byte out
+//! [`Mpu6xxx::read_register`] returns the value (and may latch FIFO_COUNT, which is harmless if
+//! the byte is never clocked out); [`Mpu6xxx::commit_read`] applies what clocking the byte out
 //! does — popping the FIFO, clearing INT_STATUS or I2C_MST_STATUS. The I2C target commits at once.
 
-use margemu_protocol::regmap::mpu9250::{
+use margemu_protocol::regmap::mpu6xxx::{
     bits, is_read_only, reg, reset_value, write_mask, DATA_LEN, SENSOR_LEN,
 };
 
 use super::super::Bus;
-use super::Mpu9250;
+use super::Mpu6xxx;
 
 const DATA: core::ops::RangeInclusive<usize> =
     reg::ACCEL_XOUT_H as usize..=reg::EXT_SENS_DATA_23 as usize;
 
-impl Mpu9250 {
+impl Mpu6xxx {
     /// Device reset (PWR_MGMT_1.H_RESET, and power-on): every register to its reset value with
     /// the part's factory trim; FIFO, interrupt and master state cleared. The AK8963 is a
     /// separate die and keeps its state.

@@ -18,7 +18,7 @@
 //! computes DRDY/DOR itself.
 //!
 //! ```
-//! use margemu_protocol::regmap::image::{ImageConfig, ImageRepr, IMAGE_LEN};
+//! use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr, IMAGE_LEN};
 //! let cfg = ImageConfig::default(); // ±2 g, ±250 °/s, 14-bit, ASA 128
 //! let repr = ImageRepr::from_physical([0.0, 0.0, 9.80665], [0.0; 3], 21.0, [0.6, 0.0, 0.0], &cfg);
 //! let bytes = repr.emit();
@@ -30,11 +30,11 @@
 
 use core::ops::Range;
 
-use super::ak8963::{self, MagBits};
 use super::convert::{
     accel_to_raw_with_offset, gyro_to_raw_with_offset, mag_measurement, temp_to_raw,
 };
-use super::mpu9250::{AccelFs, GyroFs};
+use super::{AccelFs, GyroFs};
+use crate::regmap::ak8963::{self, MagBits};
 
 /// Length of a register image in bytes.
 pub const IMAGE_LEN: usize = 22;

@@ -1,29 +1,29 @@
-//! The MPU-9250 (accel + gyro + temperature) with its AK8963 magnetometer, register by register.
+//! The InvenSense 6xxx family (MPU-9250 and its variants: accel + gyro + temperature) with the AK8963 magnetometer, register by register.
 //!
-//! [`Mpu9250`] serves both bus-target traits: [`SpiTarget`](super::SpiTarget) (first byte
+//! [`Mpu6xxx`] serves both bus-target traits: [`SpiTarget`](super::SpiTarget) (first byte
 //! `0x80 | address` reads, `address` writes; bursts increment the address except on FIFO_R_W and
 //! MEM_R_W) and [`I2cTarget`](super::I2cTarget) (0x68, or 0x69 with AD0 high; the AK8963 answers
 //! at 0x0C while INT_PIN_CFG.BYPASS_EN is set and USER_CTRL.I2C_MST_EN is clear).
 //!
-//! **Samples.** The board calls [`Mpu9250::latch_at`] once per sample period
-//! ([`Mpu9250::sample_period_ns`], which follows SMPLRT_DIV, CONFIG and GYRO_CONFIG) with the
-//! physical sample and its instant in ns; [`Mpu9250::latch`] does the same at the next instant
+//! **Samples.** The board calls [`Mpu6xxx::latch_at`] once per sample period
+//! ([`Mpu6xxx::sample_period_ns`], which follows SMPLRT_DIV, CONFIG and GYRO_CONFIG) with the
+//! physical sample and its instant in ns; [`Mpu6xxx::latch`] does the same at the next instant
 //! of the chip's own sample clock (its clock + one period), for callers that count samples.
-//! [`Mpu9250::latch_image_at`] / [`Mpu9250::latch_image`] take a finished
-//! [register image](margemu_protocol::regmap::image) instead (source mode (a)). A latch converts
+//! [`Mpu6xxx::latch_image_at`] / [`Mpu6xxx::latch_image`] take a finished
+//! [register image](margemu_protocol::regmap::mpu6xxx::image) instead (source mode (a)). A latch converts
 //! through the shared `regmap` conversions, runs the AK8963's own 8/100 Hz schedule, the
 //! auxiliary I2C master's slaves and the FIFO, sets RAW_DATA_RDY and swaps the data registers in
 //! one step: a burst that is in progress completes with the old sample, and the new one appears
 //! when the bus goes idle.
 //!
-//! **Interrupt pin.** [`Mpu9250::int_pin`] is the INT level the board drives on a GPIO: held
+//! **Interrupt pin.** [`Mpu6xxx::int_pin`] is the INT level the board drives on a GPIO: held
 //! while an enabled status bit is set (LATCH_INT_EN) or a 50 µs pulse from each latch; active
-//! high or low (ACTL). Time only moves with the latches and [`Mpu9250::advance`].
+//! high or low (ACTL). Time only moves with the latches and [`Mpu6xxx::advance`].
 //!
 //! ```
-//! use margemu_firmware::chip::{Mpu9250, PhysicalSample, SpiTarget};
-//! let mut chip = Mpu9250::new();
-//! let spi = |chip: &mut Mpu9250, bytes: &[u8]| -> [u8; 3] {
+//! use margemu_firmware::chip::{Mpu6xxx, PhysicalSample, SpiTarget};
+//! let mut chip = Mpu6xxx::new();
+//! let spi = |chip: &mut Mpu6xxx, bytes: &[u8]| -> [u8; 3] {
 //!     let mut miso = [0; 3];
 //!     miso[0] = chip.select();
 //!     for (i, b) in bytes.iter().enumerate() {
@@ -49,8 +49,8 @@ mod sample;
 mod spi;
 
 use margemu_protocol::regmap::ak8963::{self as ak_map, MagBits};
-use margemu_protocol::regmap::image::{ImageConfig, IMAGE_LEN};
-use margemu_protocol::regmap::mpu9250::{bits, reg, sample_period_ns, AccelFs, GyroFs, DATA_LEN};
+use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, IMAGE_LEN};
+use margemu_protocol::regmap::mpu6xxx::{bits, reg, sample_period_ns, AccelFs, GyroFs, DATA_LEN};
 
 use super::ak8963::Ak8963;
 use super::write_log::{RegisterWrite, WriteLog};
@@ -131,7 +131,7 @@ impl Default for Config {
 
 /// The emulated MPU-9250 (see the [module docs](self)).
 #[derive(Clone, Debug)]
-pub struct Mpu9250 {
+pub struct Mpu6xxx {
     config: Config,
     /// Stored register values; 0x3B..=0x60 are the data registers the bus sees.
     regs: [u8; 128],
@@ -152,13 +152,13 @@ pub struct Mpu9250 {
     log: WriteLog<WRITE_LOG_LEN>,
 }
 
-impl Default for Mpu9250 {
+impl Default for Mpu6xxx {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl Mpu9250 {
+impl Mpu6xxx {
     /// An MPU-9250 just powered on, with the default [`Config`].
     pub fn new() -> Self {
         Self::with_config(Config::default())
@@ -190,7 +190,7 @@ impl Mpu9250 {
         chip
     }
 
-    /// Power cycle: both dies and the bus state as from [`Mpu9250::with_config`]; the clock and the
+    /// Power cycle: both dies and the bus state as from [`Mpu6xxx::with_config`]; the clock and the
     /// write log are kept.
     pub fn power_cycle(&mut self) {
         let now_ns = self.now_ns;
@@ -230,7 +230,7 @@ impl Mpu9250 {
             && self.regs[usize::from(reg::USER_CTRL)] & bits::USER_I2C_MST_EN == 0
     }
 
-    /// The chip's clock: the latest instant given to a latch or [`Mpu9250::advance`].
+    /// The chip's clock: the latest instant given to a latch or [`Mpu6xxx::advance`].
     pub fn now_ns(&self) -> u64 {
         self.now_ns
     }
@@ -276,13 +276,13 @@ impl Mpu9250 {
     }
 
     /// Latches one physical sample at the next instant of the chip's sample clock:
-    /// [`Mpu9250::now_ns`] + [`Mpu9250::sample_period_ns`].
+    /// [`Mpu6xxx::now_ns`] + [`Mpu6xxx::sample_period_ns`].
     pub fn latch(&mut self, sample: &PhysicalSample) {
         self.latch_at(sample, self.next_sample_ns());
     }
 
     /// Latches one finished register image taken at `now_ns` (source mode (a)); see
-    /// [`margemu_protocol::regmap::image`] for the layout.
+    /// [`margemu_protocol::regmap::mpu6xxx::image`] for the layout.
     pub fn latch_image_at(&mut self, image: &[u8; IMAGE_LEN], now_ns: u64) {
         self.latch_registers(image, now_ns);
     }
@@ -325,7 +325,7 @@ impl Mpu9250 {
         self.int_asserted_at(now_ns) != active_low
     }
 
-    /// The level of the INT pin at the chip's clock ([`Mpu9250::now_ns`]).
+    /// The level of the INT pin at the chip's clock ([`Mpu6xxx::now_ns`]).
     pub fn int_pin(&self) -> bool {
         self.int_pin_at(self.now_ns)
     }

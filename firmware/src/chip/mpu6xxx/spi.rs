@@ -8,10 +8,10 @@
 //! byte went out; the prefetch after the last byte of a burst is discarded by deselect. MISO
 //! during the address byte and during writes is 0x00.
 
-use margemu_protocol::regmap::mpu9250::next_address;
+use margemu_protocol::regmap::mpu6xxx::next_address;
 
 use super::super::{Bus, SpiTarget};
-use super::Mpu9250;
+use super::Mpu6xxx;
 
 /// Where the SPI transaction is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,7 +32,7 @@ impl SpiPhase {
     }
 }
 
-impl SpiTarget for Mpu9250 {
+impl SpiTarget for Mpu6xxx {
     fn select(&mut self) -> u8 {
         self.spi = SpiPhase::Address;
         0x00

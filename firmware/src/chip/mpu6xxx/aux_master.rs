@@ -17,10 +17,10 @@
 
 use core::ops::Range;
 
-use margemu_protocol::regmap::mpu9250::{bits, reg, EXT_SENS_LEN};
+use margemu_protocol::regmap::mpu6xxx::{bits, reg, EXT_SENS_LEN};
 
 use super::super::Bus;
-use super::Mpu9250;
+use super::Mpu6xxx;
 use margemu_protocol::regmap::ak8963::I2C_ADDRESS as AK_ADDRESS;
 
 /// Master state that is not in registers.
@@ -41,7 +41,7 @@ impl AuxState {
     }
 }
 
-impl Mpu9250 {
+impl Mpu6xxx {
     fn master_enabled(&self) -> bool {
         self.regs[usize::from(reg::USER_CTRL)] & bits::USER_I2C_MST_EN != 0
     }

@@ -7,16 +7,16 @@
 //! cannot produce, so the choice only has to be fixed and documented); ±∞ saturate.
 //!
 //! ```
-//! use margemu_protocol::regmap::convert::{accel_to_raw, gyro_to_raw, temp_to_raw, STANDARD_GRAVITY};
-//! use margemu_protocol::regmap::mpu9250::{AccelFs, GyroFs};
+//! use margemu_protocol::regmap::mpu6xxx::convert::{accel_to_raw, gyro_to_raw, temp_to_raw, STANDARD_GRAVITY};
+//! use margemu_protocol::regmap::mpu6xxx::{AccelFs, GyroFs};
 //! assert_eq!(accel_to_raw(STANDARD_GRAVITY, AccelFs::G2), 16384);
 //! assert_eq!(accel_to_raw(-1e30, AccelFs::G2), -32768);
 //! assert_eq!(gyro_to_raw(core::f32::consts::PI, GyroFs::Dps2000), 2952); // 180 °/s · 16.4
 //! assert_eq!(temp_to_raw(21.0), 0);
 //! ```
 
-use super::ak8963::{MagBits, OVERFLOW_SUM_UT, SELF_TEST_14BIT};
-use super::mpu9250::{AccelFs, GyroFs};
+use super::{AccelFs, GyroFs};
+use crate::regmap::ak8963::{MagBits, OVERFLOW_SUM_UT, SELF_TEST_14BIT};
 
 /// Standard gravity (m/s²) used for 1 g.
 pub const STANDARD_GRAVITY: f32 = 9.80665;
