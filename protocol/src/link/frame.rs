@@ -377,9 +377,11 @@ mod tests {
 
     #[test]
     fn oversized_message_is_refused() {
-        use crate::link::{ImageBatch, IMAGE_LEN, MAX_FRAME_LEN, MAX_IMAGES_PER_BATCH};
-        let images = [[0u8; IMAGE_LEN]; MAX_IMAGES_PER_BATCH + 1];
-        let mut buf = [0u8; MAX_FRAME_LEN + IMAGE_LEN];
+        use crate::link::{max_images_per_batch, Image, ImageBatch, MAX_FRAME_LEN};
+        // At most 1526 payload bytes: the 9-byte header and 47 images of 32 bytes (1513).
+        let images = [Image::from([0u8; 32]); 48];
+        assert_eq!(max_images_per_batch(32), 47);
+        let mut buf = [0u8; MAX_FRAME_LEN + 32];
         let too_many = FrameRepr {
             seq: 0,
             message: Message::Images(ImageBatch::new(0, &images)),
@@ -389,10 +391,10 @@ mod tests {
             seq: 0,
             message: Message::Images(ImageBatch::new(0, &images[1..])),
         };
-        assert_eq!(most.emit(&mut buf), Ok(MAX_FRAME_LEN));
+        assert_eq!(most.emit(&mut buf), Ok(MAX_FRAME_LEN - 13));
         assert_eq!(
-            Frame::new_verified(&buf[..MAX_FRAME_LEN]).map(|f| f.payload_len()),
-            Ok(1526)
+            Frame::new_verified(&buf[..MAX_FRAME_LEN - 13]).map(|f| f.payload_len()),
+            Ok(1513)
         );
         let credit = FrameRepr {
             seq: 0,

@@ -14,14 +14,14 @@
 //!
 //! ```
 //! use margemu_protocol::link::{
-//!     Accumulator, Encoder, FeedResult, FrameRepr, ImageBatch, Message, IMAGE_LEN, MAX_WIRE_LEN,
+//!     Accumulator, Encoder, FeedResult, FrameRepr, Image, ImageBatch, Message, MAX_WIRE_LEN,
 //! };
-//! // Host: a batch of 32 register images, starting at sample 640.
-//! let images = [[0x5Au8; IMAGE_LEN]; 32];
+//! // Host: a batch of 32 MPU-9250 register images (22 bytes each), starting at sample 640.
+//! let images = [Image::from([0x5Au8; 22]); 32];
 //! let mut host = Encoder::new();
 //! let mut wire = [0u8; MAX_WIRE_LEN];
 //! let n = host.encode(&Message::Images(ImageBatch::new(640, &images)), &mut wire)?;
-//! assert_eq!(n, 727); // 704 image bytes: 96.8 % of the wire bytes
+//! assert_eq!(n, 728); // 704 image bytes: 96.7 % of the wire bytes
 //! // Device: whatever chunks the UART delivers.
 //! let mut rx = Accumulator::new();
 //! let (first, second) = wire[..n].split_at(300);
@@ -66,13 +66,14 @@ pub const MAX_ENCODED_LEN: usize = cobs::max_encoding_length(MAX_FRAME_LEN);
 /// every message.
 pub const MAX_WIRE_LEN: usize = max_wire_len(MAX_FRAME_LEN);
 
-/// Worst-case wire bytes of an [`ImageBatch`] of `n` images (COBS worst case, both delimiters).
-pub const fn image_batch_wire_len(n: usize) -> usize {
-    max_wire_len(HEADER_LEN + 8 + n * IMAGE_LEN + CRC_LEN)
+/// Worst-case wire bytes of an [`ImageBatch`] of `n` images of `image_len` bytes (COBS worst
+/// case, both delimiters).
+pub const fn image_batch_wire_len(n: usize, image_len: usize) -> usize {
+    max_wire_len(HEADER_LEN + IMAGE_BATCH_HEADER_LEN + n * image_len + CRC_LEN)
 }
 
-/// Link efficiency of an [`ImageBatch`] of `n` images in the worst case: image bytes per wire
-/// byte (not counting UART start and stop bits).
-pub fn image_batch_efficiency(n: usize) -> f64 {
-    (n * IMAGE_LEN) as f64 / image_batch_wire_len(n) as f64
+/// Link efficiency of an [`ImageBatch`] of `n` images of `image_len` bytes in the worst case:
+/// image bytes per wire byte (not counting UART start and stop bits).
+pub fn image_batch_efficiency(n: usize, image_len: usize) -> f64 {
+    (n * image_len) as f64 / image_batch_wire_len(n, image_len) as f64
 }

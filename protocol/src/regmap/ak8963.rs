@@ -13,6 +13,10 @@
 /// The AK8963's 7-bit I2C address inside the MPU-9250 (CAD1 = CAD0 = 0).
 pub const I2C_ADDRESS: u8 = 0x0C;
 
+/// The fuse-ROM sensitivity adjustment values ASAX, ASAY, ASAZ of the emulated part (near 0xB0
+/// like real parts, so a driver that ignores them is caught; DS section 8.3.11).
+pub const EMULATED_ASA: [u8; 3] = [0xB0, 0xB2, 0xA7];
+
 /// The value of WIA (DS section 8.3.1).
 pub const WIA_VALUE: u8 = 0x48;
 

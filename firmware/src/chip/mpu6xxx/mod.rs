@@ -121,7 +121,7 @@ impl Default for Config {
         Self {
             variant: Variant::Mpu9250,
             ad0: false,
-            asa: [0xB0, 0xB2, 0xA7],
+            asa: margemu_protocol::regmap::ak8963::EMULATED_ASA,
             ak8963_info: 0x00,
             self_test: [0xB4, 0xB9, 0xC2, 0x6A, 0x6E, 0x77],
             accel_offset: [0x1A32, 0xE5D8, 0x2C4C],

@@ -1,5 +1,5 @@
-//! Batches of fixed-size items: register images and true kinematics (host → device), register
-//! writes (device → host).
+//! Batches of fixed-size items: register images (of the configured chip's length) and true
+//! kinematics (host → device), register writes and served reports (device → host).
 //!
 //! A batch borrows its items: when emitting, from the caller's slice ([`Items::from_slice`]);
 //! when parsed, from the frame's payload, validated once at parse time and decoded on access.
@@ -7,13 +7,13 @@
 //! items do.
 //!
 //! ```
-//! use margemu_protocol::link::{ImageBatch, Message, IMAGE_LEN};
-//! let images = [[1u8; IMAGE_LEN], [2u8; IMAGE_LEN]];
-//! let mut payload = [0u8; 8 + 2 * IMAGE_LEN];
+//! use margemu_protocol::link::{Image, ImageBatch, Message};
+//! let images = [Image::from([1u8; 22]), Image::from([2u8; 22])];
+//! let mut payload = [0u8; 9 + 2 * 22];
 //! Message::Images(ImageBatch::new(40, &images)).emit(&mut payload)?;
 //! let Message::Images(batch) = Message::parse(0x10, &payload)? else { unreachable!() };
 //! assert_eq!(batch.first_index, 40);
-//! assert_eq!(batch.images.get(1), Some([2u8; IMAGE_LEN]));
+//! assert_eq!(batch.images.get(1), Some(Image::from([2u8; 22])));
 //! assert_eq!(batch.images.iter().count(), 2);
 //! # Ok::<(), margemu_protocol::link::Error>(())
 //! ```
@@ -25,18 +25,20 @@ use margemu_model::sensor::Truth;
 use crate::link::wire::{Reader, Writer};
 use crate::link::{Error, MAX_PAYLOAD_LEN};
 
-/// Bytes of one register image: the MPU-9250 data registers and the AK8963 block, laid out
-/// by [`crate::regmap::mpu6xxx::image`] (the link carries it as opaque bytes).
-pub use crate::regmap::mpu6xxx::image::IMAGE_LEN;
-
-/// One finished register image (see [`IMAGE_LEN`]).
-pub type Image = [u8; IMAGE_LEN];
+/// One finished register image, laid out by its chip's module (the link carries it as opaque
+/// bytes of the configured model's [`image_len`](crate::chip::ChipModel::image_len)).
+pub use crate::chip::{Image, MAX_IMAGE_LEN};
 
 /// Bytes in one true-kinematics sample (13 binary32 values and a flags byte).
 pub const TRUTH_LEN: usize = 53;
 
-/// Most images in one [`ImageBatch`].
-pub const MAX_IMAGES_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 8) / IMAGE_LEN;
+/// Most images of `image_len` bytes (at least 1) in one [`ImageBatch`].
+pub const fn max_images_per_batch(image_len: usize) -> usize {
+    (MAX_PAYLOAD_LEN - IMAGE_BATCH_HEADER_LEN) / if image_len == 0 { 1 } else { image_len }
+}
+
+/// Bytes of an [`ImageBatch`] before its images: the first index and the image length.
+pub const IMAGE_BATCH_HEADER_LEN: usize = 9;
 /// Most samples in one [`KinematicsBatch`].
 pub const MAX_KINEMATICS_PER_BATCH: usize = (MAX_PAYLOAD_LEN - 8) / TRUTH_LEN;
 /// Most entries in one [`RegisterWriteBatch`].
@@ -55,19 +57,6 @@ pub trait WireItem: Sized + Copy {
     /// Checks one encoded item; by default by parsing it.
     fn validate(bytes: &[u8]) -> Result<(), Error> {
         Self::parse(bytes).map(drop)
-    }
-}
-
-impl WireItem for Image {
-    const LEN: usize = IMAGE_LEN;
-    fn parse(bytes: &[u8]) -> Result<Self, Error> {
-        Reader::new(bytes).array()
-    }
-    fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
-        w.bytes(self)
-    }
-    fn validate(_: &[u8]) -> Result<(), Error> {
-        Ok(())
     }
 }
 
@@ -166,8 +155,8 @@ const SERVED_EMPTY: u8 = 0x02;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ServedSample {
-    /// CRC-32C ([`CRC32C`](crate::link::CRC32C)) of the 22-byte image latched into the chip
-    /// (0 when `empty`).
+    /// CRC-32C ([`CRC32C`](crate::link::CRC32C)) of the image latched into the chip, its
+    /// configured length (0 when `empty`).
     pub crc32c: u32,
     /// The sample was missing (an underrun): the previous image was latched again.
     pub underrun: bool,
@@ -307,13 +296,123 @@ impl<T: WireItem + fmt::Debug> fmt::Debug for Items<'_, T> {
     }
 }
 
-/// Host → device: finished register images for consecutive samples.
+/// Host → device: finished register images for consecutive samples, all of one length.
+///
+/// Payload: `first_index` (u64), the image length (u8; 0 only when there is no image), then the
+/// images back to back.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageBatch<'a> {
     /// Index of the first image; image `k` is sample `first_index + k`.
     pub first_index: u64,
-    /// The images, at most [`MAX_IMAGES_PER_BATCH`].
-    pub images: Items<'a, Image>,
+    /// The images, at most [`max_images_per_batch`] of their length.
+    pub images: ImageItems<'a>,
+}
+
+/// The images of an [`ImageBatch`]: the caller's slice, or a validated payload region.
+#[derive(Clone, Copy)]
+pub struct ImageItems<'a> {
+    repr: ImagesRepr<'a>,
+}
+
+#[derive(Clone, Copy)]
+enum ImagesRepr<'a> {
+    Values(&'a [Image]),
+    Wire { image_len: usize, bytes: &'a [u8] },
+}
+
+impl<'a> ImageItems<'a> {
+    /// Images to emit.
+    pub const fn from_slice(images: &'a [Image]) -> Self {
+        Self {
+            repr: ImagesRepr::Values(images),
+        }
+    }
+
+    /// Bytes per image (0 when there is none).
+    pub fn image_len(&self) -> usize {
+        match self.repr {
+            ImagesRepr::Values(v) => v.first().map_or(0, |i| i.len()),
+            ImagesRepr::Wire { image_len, .. } => image_len,
+        }
+    }
+
+    /// The number of images.
+    pub fn len(&self) -> usize {
+        match self.repr {
+            ImagesRepr::Values(v) => v.len(),
+            ImagesRepr::Wire { image_len, bytes } => {
+                bytes.len().checked_div(image_len).unwrap_or(0)
+            }
+        }
+    }
+
+    /// Whether there is no image.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Image `i`.
+    pub fn get(&self, i: usize) -> Option<Image> {
+        match self.repr {
+            ImagesRepr::Values(v) => v.get(i).copied(),
+            ImagesRepr::Wire { image_len, bytes } => {
+                let at = i.checked_mul(image_len)?;
+                Image::new(bytes.get(at..at.checked_add(image_len)?)?)
+            }
+        }
+    }
+
+    /// The images, in order.
+    pub fn iter(&self) -> impl Iterator<Item = Image> + 'a {
+        let items = *self;
+        (0..self.len()).filter_map(move |i| items.get(i))
+    }
+
+    fn buffer_len(&self) -> usize {
+        1 + self.len() * self.image_len()
+    }
+
+    fn parse(r: &mut Reader<'a>) -> Result<Self, Error> {
+        let image_len = usize::from(r.u8()?);
+        let bytes = r.bytes(r.remaining().len())?;
+        if image_len > MAX_IMAGE_LEN || (image_len == 0 && !bytes.is_empty()) {
+            return Err(Error::InvalidValue);
+        }
+        if image_len != 0 && bytes.len() % image_len != 0 {
+            return Err(Error::PayloadTooLong);
+        }
+        Ok(Self {
+            repr: ImagesRepr::Wire { image_len, bytes },
+        })
+    }
+
+    fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
+        let image_len = self.image_len();
+        // image_len ≤ MAX_IMAGE_LEN (32) by construction of `Image`.
+        w.u8(image_len as u8)?;
+        match self.repr {
+            ImagesRepr::Values(v) => v.iter().try_for_each(|image| {
+                if image.len() == image_len {
+                    w.bytes(image)
+                } else {
+                    Err(Error::InvalidValue)
+                }
+            }),
+            ImagesRepr::Wire { bytes, .. } => w.bytes(bytes),
+        }
+    }
+}
+
+impl PartialEq for ImageItems<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        self.len() == other.len() && self.iter().eq(other.iter())
+    }
+}
+
+impl fmt::Debug for ImageItems<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
 }
 
 /// Host → device: true kinematics (at the configured truth rate) for consecutive samples.
@@ -378,16 +477,16 @@ impl<'a> ServedBatch<'a> {
 }
 
 impl<'a> ImageBatch<'a> {
-    /// A batch of `images` starting at sample `first_index`.
+    /// A batch of `images` (all of one length) starting at sample `first_index`.
     pub const fn new(first_index: u64, images: &'a [Image]) -> Self {
         Self {
             first_index,
-            images: Items::from_slice(images),
+            images: ImageItems::from_slice(images),
         }
     }
     pub(crate) fn parse(r: &mut Reader<'a>) -> Result<Self, Error> {
         let first_index = r.u64()?;
-        let images = Items::parse(r)?;
+        let images = ImageItems::parse(r)?;
         Ok(Self {
             first_index,
             images,

@@ -1,8 +1,9 @@
-//! [`Configure`]: which chip to emulate, its output rate, initial register values, and where the
+//! [`Configure`]: which chip to emulate (model, identity, image length, I2C address), its output rate, initial register values, and where the
 //! samples come from (register images from the host, or the on-device model with its terms).
 //!
 //! ```
 //! use margemu_model::sensor::MargConfig;
+//! use margemu_protocol::chip::ChipModel;
 //! use margemu_protocol::link::{Configure, Message, ModelParams, Rate, Source};
 //! // 1 kHz / (1 + SMPLRT_DIV = 2): not an integer rate, exact as a ratio.
 //! let rate = Rate::new(1000, 3).unwrap();
@@ -12,7 +13,7 @@
 //! marg.gyro.errors.noise_density = Some([0.0224; 3]);
 //! let cfg = Configure {
 //!     source: Source::Model(ModelParams::new(42, Rate::hz(200).unwrap(), marg)),
-//!     ..Configure::new(0x71, rate)
+//!     ..Configure::new(ChipModel::Mpu9250, rate)
 //! };
 //! let msg = Message::Configure(cfg.clone());
 //! let mut buf = [0u8; 256];
@@ -28,13 +29,14 @@ use super::model_terms::{
     marg_len, perturbation_len, read_marg, read_perturbation, write_marg, write_perturbation,
     MAX_MARG_CONFIG_LEN, MAX_PERTURBATION_LEN,
 };
+use crate::chip::ChipModel;
 use crate::link::wire::{Reader, Writer};
 use crate::link::{Error, MAX_PAYLOAD_LEN};
 
 /// Most register overrides in one [`Configure`].
 pub const MAX_OVERRIDES: usize = 32;
 
-const FIXED_LEN: usize = 1 + 1 + 8 + 8 + 1;
+const FIXED_LEN: usize = 4 + 1 + 8 + 8 + 1;
 const MODEL_FIXED_LEN: usize = 8 + 8 + 8 + 1;
 /// Largest [`Configure`] payload (every model term and the perturbation present).
 pub const MAX_CONFIGURE_LEN: usize =
@@ -96,23 +98,15 @@ impl Rate {
     }
 }
 
-code_enum! {
-    /// Which register file an override writes.
-    pub enum RegisterFile {
-        /// The MPU-9250's own registers.
-        Mpu9250 = 0,
-        /// The AK8963 magnetometer's registers.
-        Ak8963 = 1,
-    }
-}
-
-/// An initial register value, applied after the chip's reset values (e.g. GYRO_CONFIG for a
-/// full scale, or a trimmed self-test or fuse ROM value).
+/// An initial register value, applied after the chip's reset values through the chip's own bus
+/// (e.g. a full-scale register, or a trimmed self-test or fuse ROM value).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RegisterOverride {
-    /// Register file.
-    pub file: RegisterFile,
+    /// Register file, numbered by the chip model (see
+    /// [`ChipModel::register_files`](crate::chip::ChipModel::register_files)): the MPU-9250's
+    /// die 0 and AK8963 1, the ICM-42688-P's banks 0–4.
+    pub file: u8,
     /// Register address.
     pub register: u8,
     /// Value.
@@ -161,8 +155,15 @@ pub enum Source {
 /// configured and stopped states; it drops buffered samples and resets the chip.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Configure {
-    /// The chip variant, by its WHO_AM_I value (0x71 MPU-9250, 0x73, 0x70, 0x68).
+    /// The chip model.
+    pub chip: ChipModel,
+    /// The identity it answers: one of [`ChipModel::identities`].
     pub who_am_i: u8,
+    /// Bytes per register image, [`ChipModel::image_len`]: the device refuses any other, so a
+    /// host and a firmware that disagree on the image layout never stream.
+    pub image_len: u8,
+    /// Its 7-bit I2C address, one of [`ChipModel::i2c_addresses`].
+    pub i2c_address: u8,
     /// Output rate: sample `i` is served at scene time [`Rate::sample_time_ns`]`(i)` (the
     /// clock set by [`Start`](super::Start)).
     pub rate: Rate,
@@ -175,10 +176,14 @@ pub struct Configure {
 }
 
 impl Configure {
-    /// Chip `who_am_i` at `rate`, images from the host, no overrides, default telemetry.
-    pub fn new(who_am_i: u8, rate: Rate) -> Self {
+    /// `chip` with its own identity at its first I2C address, at `rate`, images from the host,
+    /// no overrides, default telemetry.
+    pub fn new(chip: ChipModel, rate: Rate) -> Self {
         Self {
-            who_am_i,
+            chip,
+            who_am_i: chip.who_am_i(),
+            image_len: chip.image_len() as u8,
+            i2c_address: chip.i2c_addresses().first().copied().unwrap_or(0),
             rate,
             telemetry_period_ns: 0,
             overrides: heapless::Vec::new(),
@@ -199,7 +204,10 @@ impl Configure {
     }
 
     pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
+        let chip = ChipModel::from_code(r.u8()?).ok_or(Error::InvalidValue)?;
         let who_am_i = r.u8()?;
+        let image_len = r.u8()?;
+        let i2c_address = r.u8()?;
         let source_tag = r.u8()?;
         let rate = Rate::read(r)?;
         let telemetry_period_ns = r.u64()?;
@@ -207,7 +215,7 @@ impl Configure {
         let mut overrides = heapless::Vec::new();
         for _ in 0..count {
             let o = RegisterOverride {
-                file: RegisterFile::read(r)?,
+                file: r.u8()?,
                 register: r.u8()?,
                 value: r.u8()?,
             };
@@ -229,7 +237,10 @@ impl Configure {
             _ => return Err(Error::InvalidValue),
         };
         Ok(Self {
+            chip,
             who_am_i,
+            image_len,
+            i2c_address,
             rate,
             telemetry_period_ns,
             overrides,
@@ -238,7 +249,12 @@ impl Configure {
     }
 
     pub(crate) fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
-        w.u8(self.who_am_i)?;
+        w.bytes(&[
+            self.chip.code(),
+            self.who_am_i,
+            self.image_len,
+            self.i2c_address,
+        ])?;
         w.u8(match self.source {
             Source::Images => 0,
             Source::Model(_) => 1,
@@ -248,7 +264,7 @@ impl Configure {
         // `overrides` holds at most MAX_OVERRIDES (32) entries.
         w.u8(self.overrides.len() as u8)?;
         for o in &self.overrides {
-            w.bytes(&[o.file as u8, o.register, o.value])?;
+            w.bytes(&[o.file, o.register, o.value])?;
         }
         if let Source::Model(m) = &self.source {
             w.u64(m.seed)?;

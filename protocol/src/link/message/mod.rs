@@ -21,10 +21,10 @@
 //! | 0x87 | [`ServedBatch`] | device → host |
 //!
 //! ```
-//! use margemu_protocol::link::{ImageBatch, Kind, Message, IMAGE_LEN};
-//! let images = [[0x11u8; IMAGE_LEN]; 2];
+//! use margemu_protocol::link::{Image, ImageBatch, Kind, Message};
+//! let images = [Image::from([0x11u8; 22]); 2];
 //! let msg = Message::Images(ImageBatch::new(1000, &images));
-//! assert_eq!((msg.kind(), msg.buffer_len()), (Kind::Images, 8 + 2 * IMAGE_LEN));
+//! assert_eq!((msg.kind(), msg.buffer_len()), (Kind::Images, 9 + 2 * 22));
 //! let mut payload = [0u8; 64];
 //! let n = msg.emit(&mut payload)?;
 //! let back = Message::parse(Kind::Images as u8, &payload[..n])?;
@@ -41,11 +41,12 @@ mod session;
 mod status;
 
 pub use batch::{
-    Bus, Image, ImageBatch, Items, KinematicsBatch, RegisterWrite, RegisterWriteBatch, ServedBatch,
-    ServedSample, WireItem, IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH,
-    MAX_REGISTER_WRITES_PER_BATCH, MAX_SERVED_PER_BATCH, TRUTH_LEN,
+    max_images_per_batch, Bus, Image, ImageBatch, ImageItems, Items, KinematicsBatch,
+    RegisterWrite, RegisterWriteBatch, ServedBatch, ServedSample, WireItem, IMAGE_BATCH_HEADER_LEN,
+    MAX_IMAGE_LEN, MAX_KINEMATICS_PER_BATCH, MAX_REGISTER_WRITES_PER_BATCH, MAX_SERVED_PER_BATCH,
+    TRUTH_LEN,
 };
-pub use configure::{Configure, ModelParams, Rate, RegisterFile, RegisterOverride, Source};
+pub use configure::{Configure, ModelParams, Rate, RegisterOverride, Source};
 pub use configure::{MAX_CONFIGURE_LEN, MAX_OVERRIDES};
 pub use model_terms::{MAX_MARG_CONFIG_LEN, MAX_PERTURBATION_LEN};
 pub use session::{

@@ -2,42 +2,56 @@
 //! [`ErrorReport`], with the capability sets the device advertises.
 //!
 //! ```
+//! use margemu_protocol::chip::ChipModel;
 //! use margemu_protocol::link::{Capabilities, Chips, Modes};
-//! let caps = Capabilities { chips: Chips::MPU9250 | Chips::MPU6500, ..Capabilities::default() };
-//! assert!(caps.chips.contains(Chips::for_who_am_i(0x71).unwrap()));
+//! let chips = Chips::of(ChipModel::Mpu9250) | Chips::of(ChipModel::Icm42688p);
+//! let caps = Capabilities { chips, ..Capabilities::default() };
+//! assert!(caps.chips.has(ChipModel::Icm42688p) && !caps.chips.has(ChipModel::Mpu6000));
 //! assert!(!caps.modes.contains(Modes::MODEL));
 //! ```
 
+use crate::chip::ChipModel;
 use crate::link::wire::{Reader, Writer};
 use crate::link::Error;
 
 /// Length of the device identifier in [`HelloAck`] (an MCU unique ID, zero-padded).
 pub const DEVICE_ID_LEN: usize = 16;
 
-flags! {
-    /// The chip variants a device can emulate, by WHO_AM_I.
-    pub struct Chips {
-        /// MPU-9250, WHO_AM_I 0x71.
-        const MPU9250 = 0;
-        /// MPU-9255, WHO_AM_I 0x73.
-        const MPU9255 = 1;
-        /// MPU-6500 (no magnetometer), WHO_AM_I 0x70.
-        const MPU6500 = 2;
-        /// The 0x68 variant (MPU-9150/MPU-6050 register map subset), WHO_AM_I 0x68.
-        const WHO_AM_I_68 = 3;
+/// The chip models a device can emulate: bit `n` is the [`ChipModel`] of code `n`; unknown bits
+/// are kept (a newer peer may set them).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Chips(pub u32);
+
+impl Chips {
+    /// No chip.
+    pub const EMPTY: Self = Self(0);
+
+    /// The set of one model.
+    pub const fn of(model: ChipModel) -> Self {
+        Self(1 << model.code())
+    }
+
+    /// Whether every model of `other` is in `self`.
+    pub fn contains(self, other: Self) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Whether `model` is in the set.
+    pub fn has(self, model: ChipModel) -> bool {
+        self.contains(Self::of(model))
+    }
+
+    /// The known models in the set, in code order.
+    pub fn models(self) -> impl Iterator<Item = ChipModel> {
+        ChipModel::ALL.into_iter().filter(move |m| self.has(*m))
     }
 }
 
-impl Chips {
-    /// The flag of the chip that answers WHO_AM_I with `who_am_i`.
-    pub fn for_who_am_i(who_am_i: u8) -> Option<Self> {
-        Some(match who_am_i {
-            0x71 => Self::MPU9250,
-            0x73 => Self::MPU9255,
-            0x70 => Self::MPU6500,
-            0x68 => Self::WHO_AM_I_68,
-            _ => return None,
-        })
+impl core::ops::BitOr for Chips {
+    type Output = Self;
+    fn bitor(self, rhs: Self) -> Self {
+        Self(self.0 | rhs.0)
     }
 }
 
@@ -65,7 +79,7 @@ flags! {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Capabilities {
-    /// Emulated chip variants.
+    /// Emulated chip models.
     pub chips: Chips,
     /// Sample sources.
     pub modes: Modes,
@@ -135,7 +149,7 @@ pub struct HelloAck {
 
 impl HelloAck {
     /// Payload length.
-    pub const LEN: usize = 2 + 4 + 3 + DEVICE_ID_LEN + 3 + 2 + 4;
+    pub const LEN: usize = 2 + 4 + 3 + DEVICE_ID_LEN + 4 + 2 + 2 + 4;
 
     pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
         Ok(Self {
@@ -148,7 +162,7 @@ impl HelloAck {
             },
             device_id: r.array()?,
             capabilities: Capabilities {
-                chips: Chips(r.u8()?),
+                chips: Chips(r.u32()?),
                 modes: Modes(r.u8()?),
                 buses: Buses(r.u8()?),
                 max_batch: r.u16()?,
@@ -167,7 +181,8 @@ impl HelloAck {
         ])?;
         w.bytes(&self.device_id)?;
         let c = &self.capabilities;
-        w.bytes(&[c.chips.0, c.modes.0, c.buses.0])?;
+        w.u32(c.chips.0)?;
+        w.bytes(&[c.modes.0, c.buses.0])?;
         w.u16(c.max_batch)?;
         w.u32(c.buffer_capacity)
     }

@@ -31,13 +31,18 @@
 use core::ops::Range;
 
 use super::convert::{
-    accel_to_raw_with_offset, gyro_to_raw_with_offset, mag_measurement, temp_to_raw,
+    accel_to_raw_with_offset, asa_factor, gyro_to_raw_with_offset, mag_measurement, temp_to_raw,
+    STANDARD_GRAVITY, TEMP_LSB_PER_C, TEMP_OFFSET_C,
 };
 use super::{AccelFs, GyroFs};
 use crate::regmap::ak8963::{self, MagBits};
 
-/// Length of a register image in bytes.
+/// Length of a register image in bytes (a part with the AK8963).
 pub const IMAGE_LEN: usize = 22;
+
+/// Length of the image of a part without magnetometer (MPU-6000, MPU-6500, ICM-20602): the
+/// first [`field::SENSORS`] bytes alone.
+pub const SENSORS_LEN: usize = 14;
 
 /// Byte ranges of the image's fields.
 pub mod field {
@@ -199,6 +204,57 @@ impl ImageRepr {
             st2 |= ak8963::bits::ST2_BITM;
         }
         st2
+    }
+}
+
+/// One image decoded back to physical units (the inverse of [`ImageRepr::from_physical`] to
+/// within one LSB; what the chip clipped stays clipped).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Physical {
+    /// Specific force (m/s²), MPU axes.
+    pub acc: [f64; 3],
+    /// Angular rate (rad/s), MPU axes.
+    pub gyr: [f64; 3],
+    /// Die temperature (°C).
+    pub temp_c: f64,
+    /// Magnetic field (µT), back in the MPU's accel/gyro axes.
+    pub mag_ut: [f64; 3],
+}
+
+impl ImageRepr {
+    /// The physical values these register values stand for under `cfg`: accel and gyro user
+    /// offsets removed, the AK8963's sensitivity adjustment (ASA) applied and its axes mapped
+    /// back to the MPU's (`x = y_ak, y = x_ak, z = −z_ak`).
+    pub fn to_physical(&self, cfg: &ImageConfig) -> Physical {
+        let lsb_per_g = f64::from(cfg.accel_fs.lsb_per_g());
+        let lsb_per_radps = f64::from(cfg.gyro_fs.lsb_per_dps()) * 180.0 / core::f64::consts::PI;
+        let gyro_offset_lsb =
+            |i: usize| f64::from(cfg.gyro_offset[i]) * 4.0 / f64::from(1u8 << cfg.gyro_fs.bits());
+        let ut = |i: usize| {
+            f64::from(self.mag[i])
+                * f64::from(cfg.mag_bits.ut_per_lsb())
+                * f64::from(asa_factor(cfg.asa[i]))
+        };
+        Physical {
+            acc: core::array::from_fn(|i| {
+                let offset = f64::from(cfg.accel_offset[i] & !1) * lsb_per_g / 2048.0;
+                (f64::from(self.accel[i]) - offset) / lsb_per_g * f64::from(STANDARD_GRAVITY)
+            }),
+            gyr: core::array::from_fn(|i| {
+                (f64::from(self.gyro[i]) - gyro_offset_lsb(i)) / lsb_per_radps
+            }),
+            temp_c: f64::from(self.temp) / f64::from(TEMP_LSB_PER_C) + f64::from(TEMP_OFFSET_C),
+            mag_ut: [ut(1), ut(0), -ut(2)],
+        }
+    }
+
+    /// Decodes the first [`SENSORS_LEN`] bytes and, when present, the AK8963 block of an image
+    /// of either length (a shorter slice is zero-padded).
+    pub fn parse_slice(bytes: &[u8]) -> Self {
+        let mut full = [0u8; IMAGE_LEN];
+        let n = bytes.len().min(IMAGE_LEN);
+        full[..n].copy_from_slice(&bytes[..n]);
+        Self::parse(&full)
     }
 }
 

@@ -311,6 +311,11 @@ impl AccelFs {
         self as u8
     }
 
+    /// The range, ± g.
+    pub const fn range_g(self) -> u16 {
+        2 << self.bits()
+    }
+
     /// Sensitivity in LSB per g (PS section 3).
     pub const fn lsb_per_g(self) -> f32 {
         match self {
@@ -348,6 +353,11 @@ impl GyroFs {
     /// The GYRO_FS_SEL field value (0..=3).
     pub const fn bits(self) -> u8 {
         self as u8
+    }
+
+    /// The range, ± °/s.
+    pub const fn range_dps(self) -> u16 {
+        250 << self.bits()
     }
 
     /// Sensitivity in LSB per °/s as the product specification states it (section 3.1:

@@ -1,0 +1,100 @@
+//! [`Image`]: one sample's register image, of its chip model's length.
+
+use core::fmt;
+use core::ops::Deref;
+
+/// The longest image of any model (the ICM-42688-P's 32 bytes).
+pub const MAX_IMAGE_LEN: usize = 32;
+
+/// One sample's register image: `len` bytes laid out by the chip module of its model (see
+/// [`ChipModel::image_len`](super::ChipModel::image_len)), the unit the link carries in source
+/// mode (a). Dereferences to its bytes; the bytes beyond `len` are always zero, so equality and
+/// hashing see only the image.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Image {
+    len: u8,
+    bytes: [u8; MAX_IMAGE_LEN],
+}
+
+impl Image {
+    /// An image of `bytes`; `None` if longer than [`MAX_IMAGE_LEN`].
+    pub fn new(bytes: &[u8]) -> Option<Self> {
+        let mut image = Self::zeroed(bytes.len())?;
+        image.bytes.get_mut(..bytes.len())?.copy_from_slice(bytes);
+        Some(image)
+    }
+
+    /// An image of `len` zero bytes; `None` if longer than [`MAX_IMAGE_LEN`].
+    pub fn zeroed(len: usize) -> Option<Self> {
+        (len <= MAX_IMAGE_LEN).then_some(Self {
+            len: len as u8,
+            bytes: [0; MAX_IMAGE_LEN],
+        })
+    }
+
+    /// The image's bytes.
+    pub fn as_bytes(&self) -> &[u8] {
+        &self.bytes[..usize::from(self.len).min(MAX_IMAGE_LEN)]
+    }
+
+    /// The image's bytes, to fill.
+    pub fn as_mut_bytes(&mut self) -> &mut [u8] {
+        let len = usize::from(self.len).min(MAX_IMAGE_LEN);
+        &mut self.bytes[..len]
+    }
+}
+
+impl Default for Image {
+    /// The empty image.
+    fn default() -> Self {
+        Self {
+            len: 0,
+            bytes: [0; MAX_IMAGE_LEN],
+        }
+    }
+}
+
+impl Deref for Image {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        self.as_bytes()
+    }
+}
+
+impl AsRef<[u8]> for Image {
+    fn as_ref(&self) -> &[u8] {
+        self.as_bytes()
+    }
+}
+
+impl<const N: usize> From<[u8; N]> for Image {
+    /// An image of an array; arrays longer than [`MAX_IMAGE_LEN`] keep their first bytes.
+    fn from(bytes: [u8; N]) -> Self {
+        let n = N.min(MAX_IMAGE_LEN);
+        Self::new(&bytes[..n]).unwrap_or_default()
+    }
+}
+
+impl fmt::Debug for Image {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Image(")?;
+        for b in self.as_bytes() {
+            write!(f, "{b:02x}")?;
+        }
+        write!(f, ")")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn length_and_bytes() {
+        let image = Image::new(&[1, 2, 3]).unwrap();
+        assert_eq!((image.len(), &image[..]), (3, &[1u8, 2, 3][..]));
+        assert_eq!(Image::from([1u8, 2, 3]), image);
+        assert_ne!(Image::new(&[1, 2, 3, 0]).unwrap(), image);
+        assert!(Image::new(&[0; MAX_IMAGE_LEN + 1]).is_none());
+    }
+}

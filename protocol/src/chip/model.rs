@@ -1,0 +1,203 @@
+//! [`ChipModel`]: the emulated chip models and what the rest of margemu may know about each
+//! without naming a register.
+
+use crate::link::Buses;
+
+// MERGE: from regmap::icm42688p once it lands.
+const ICM42688P_IMAGE_LEN: usize = 32;
+const ICM42688P_ODRS_HZ: [f64; 12] = [
+    32_000.0, 16_000.0, 8_000.0, 4_000.0, 2_000.0, 1_000.0, 500.0, 200.0, 100.0, 50.0, 25.0, 12.5,
+];
+
+/// The register-map family a model belongs to: one chip module each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Family {
+    /// InvenSense 6xxx: MPU-9250 (with the AK8963), MPU-6500, MPU-6000, ICM-20602
+    /// ([`crate::regmap::mpu6xxx`]).
+    Mpu6xxx,
+    /// TDK InvenSense ICM-42688-P ([`crate::regmap::icm42688p`]).
+    Icm42688p,
+}
+
+/// An emulated chip model. Its wire code ([`ChipModel::code`]) is the bit of
+/// [`Chips`](crate::link::Chips) and the chip byte of [`Configure`](crate::link::Configure).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum ChipModel {
+    /// InvenSense MPU-9250 with the AK8963 magnetometer (identities 0x71, MPU-9255 0x73, 0x68).
+    Mpu9250 = 0,
+    /// InvenSense MPU-6500, WHO_AM_I 0x70.
+    Mpu6500 = 1,
+    /// InvenSense MPU-6000, WHO_AM_I 0x68 (and PRODUCT_ID).
+    Mpu6000 = 2,
+    /// TDK InvenSense ICM-20602, WHO_AM_I 0x12.
+    Icm20602 = 3,
+    /// TDK InvenSense ICM-42688-P, WHO_AM_I 0x47.
+    Icm42688p = 4,
+}
+
+impl ChipModel {
+    /// Every model, in code order.
+    pub const ALL: [Self; 5] = [
+        Self::Mpu9250,
+        Self::Mpu6500,
+        Self::Mpu6000,
+        Self::Icm20602,
+        Self::Icm42688p,
+    ];
+
+    /// The model's code on the link.
+    pub const fn code(self) -> u8 {
+        self as u8
+    }
+
+    /// The model of a wire code.
+    pub fn from_code(code: u8) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.code() == code)
+    }
+
+    /// The name scenes, files and the command line use (`"icm42688p"`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Mpu9250 => "mpu9250",
+            Self::Mpu6500 => "mpu6500",
+            Self::Mpu6000 => "mpu6000",
+            Self::Icm20602 => "icm20602",
+            Self::Icm42688p => "icm42688p",
+        }
+    }
+
+    /// The datasheet's part name (`"ICM-42688-P"`).
+    pub const fn part_name(self) -> &'static str {
+        match self {
+            Self::Mpu9250 => "MPU-9250",
+            Self::Mpu6500 => "MPU-6500",
+            Self::Mpu6000 => "MPU-6000",
+            Self::Icm20602 => "ICM-20602",
+            Self::Icm42688p => "ICM-42688-P",
+        }
+    }
+
+    /// The model called `name` ([`ChipModel::name`], ASCII case and `-`/`_` ignored).
+    pub fn from_name(name: &str) -> Option<Self> {
+        let mut key = [0u8; 16];
+        let mut n = 0;
+        for b in name.bytes().filter(|b| !matches!(b, b'-' | b'_')) {
+            *key.get_mut(n)? = b.to_ascii_lowercase();
+            n += 1;
+        }
+        let key = key.get(..n)?;
+        Self::ALL.into_iter().find(|m| m.name().as_bytes() == key)
+    }
+
+    /// The register-map family.
+    pub const fn family(self) -> Family {
+        match self {
+            Self::Icm42688p => Family::Icm42688p,
+            _ => Family::Mpu6xxx,
+        }
+    }
+
+    /// The WHO_AM_I value of the part itself (the first of [`ChipModel::identities`]).
+    pub const fn who_am_i(self) -> u8 {
+        self.identities()[0]
+    }
+
+    /// Every WHO_AM_I value the model can be told to answer (identity variants of one register
+    /// map: the MPU-9255 and the 0x68 parts behave as the MPU-9250).
+    pub const fn identities(self) -> &'static [u8] {
+        match self {
+            Self::Mpu9250 => &[0x71, 0x73, 0x68],
+            Self::Mpu6500 => &[0x70],
+            Self::Mpu6000 => &[0x68],
+            Self::Icm20602 => &[0x12],
+            Self::Icm42688p => &[0x47],
+        }
+    }
+
+    /// The buses the part has (every current model: SPI and I2C).
+    pub const fn buses(self) -> Buses {
+        Buses(Buses::SPI.0 | Buses::I2C.0)
+    }
+
+    /// The 7-bit I2C addresses the part can be strapped to (AD0 low first).
+    pub const fn i2c_addresses(self) -> &'static [u8] {
+        &[0x68, 0x69]
+    }
+
+    /// Register files of the model, as [`RegisterOverride::file`](crate::link::RegisterOverride)
+    /// numbers them: the MPU-9250's die (0) and its AK8963 (1); the ICM-42688-P's banks 0–4;
+    /// one file otherwise.
+    pub const fn register_files(self) -> u8 {
+        match self {
+            Self::Mpu9250 => 2,
+            Self::Icm42688p => 5,
+            _ => 1,
+        }
+    }
+
+    /// Whether the package holds a magnetometer.
+    pub const fn has_magnetometer(self) -> bool {
+        matches!(self, Self::Mpu9250)
+    }
+
+    /// Bytes of one register image of this model (see each chip module's `image`).
+    pub const fn image_len(self) -> usize {
+        match self {
+            Self::Mpu9250 => crate::regmap::mpu6xxx::image::IMAGE_LEN,
+            Self::Mpu6500 | Self::Mpu6000 | Self::Icm20602 => {
+                crate::regmap::mpu6xxx::image::SENSORS_LEN
+            }
+            Self::Icm42688p => ICM42688P_IMAGE_LEN,
+        }
+    }
+
+    /// Whether the part can output samples at `rate_hz` (within 1e-9 relative): the rates its
+    /// rate registers give (InvenSense 6xxx: 8 kHz or 1 kHz divided by 1 + SMPLRT_DIV, and
+    /// 32 kHz with the DLPF bypassed; ICM-42688-P: its ODR codes).
+    pub fn has_output_rate(self, rate_hz: f64) -> bool {
+        let close = |r: f64| (r - rate_hz).abs() <= 1e-9 * r;
+        match self.family() {
+            Family::Mpu6xxx => {
+                close(32_000.0)
+                    || (0..=255u32).any(|div| {
+                        close(8_000.0 / f64::from(div + 1)) || close(1_000.0 / f64::from(div + 1))
+                    })
+            }
+            Family::Icm42688p => ICM42688P_ODRS_HZ.iter().any(|&r| close(r)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn codes_and_names_round_trip() {
+        for m in ChipModel::ALL {
+            assert_eq!(ChipModel::from_code(m.code()), Some(m));
+            assert_eq!(ChipModel::from_name(m.name()), Some(m));
+            assert!(m.image_len() <= super::super::MAX_IMAGE_LEN);
+        }
+        assert_eq!(
+            ChipModel::from_name("ICM-42688-P"),
+            Some(ChipModel::Icm42688p)
+        );
+        assert_eq!(ChipModel::from_name("MPU_6000"), Some(ChipModel::Mpu6000));
+        assert_eq!(ChipModel::from_name("bmi270"), None);
+        assert_eq!(ChipModel::from_name("an-overlong-name-of-no-chip"), None);
+        assert_eq!(ChipModel::from_code(200), None);
+    }
+
+    #[test]
+    fn output_rates() {
+        assert!(ChipModel::Mpu9250.has_output_rate(200.0));
+        assert!(ChipModel::Mpu9250.has_output_rate(8000.0));
+        assert!(!ChipModel::Mpu9250.has_output_rate(64_000.0));
+        assert!(ChipModel::Icm42688p.has_output_rate(8000.0));
+        assert!(ChipModel::Icm42688p.has_output_rate(12.5));
+        assert!(!ChipModel::Icm42688p.has_output_rate(300.0));
+    }
+}
