@@ -16,6 +16,9 @@
 //! the byte the target drives; [`I2cTarget::stop`] ends the transaction. A target that did not
 //! acknowledge its address ignores the following bytes until the next START.
 //!
+//! **The boundary.** [`Chip`] is what the link handler, the SPI shadow, the boards and the host
+//! use of any chip; [`EmulatedChip`] is the chip a device runs, chosen by the host's Configure.
+//!
 //! Chips:
 //! - [`Mpu6xxx`]: the InvenSense 6xxx family (the MPU-9250 and its WHO_AM_I variants) with the [`Ak8963`]
 //!   magnetometer behind its auxiliary I2C master or in bypass mode;
@@ -24,10 +27,12 @@
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
 mod ak8963;
+mod emulated;
 pub mod mpu6xxx;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
+pub use emulated::{Chip, EmulatedChip};
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 
@@ -54,16 +59,5 @@ pub trait I2cTarget {
     fn stop(&mut self);
 }
 
-/// One physical sample as the chip's sensors would see it, in the chip's accel/gyro axes
-/// (the AK8963's own axis quirks are applied inside the chip model).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PhysicalSample {
-    /// Specific force (m/s²).
-    pub acc: [f32; 3],
-    /// Angular rate (rad/s).
-    pub gyr: [f32; 3],
-    /// Magnetic field (µT).
-    pub mag: [f32; 3],
-    /// Die temperature (°C).
-    pub temp_c: f32,
-}
+/// One physical sample as the chip's sensors would see it (defined by the chip boundary).
+pub use margemu_protocol::chip::PhysicalSample;

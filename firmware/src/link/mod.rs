@@ -13,7 +13,8 @@
 //!
 //! **Refusals.** Each is answered with an Error frame and counted in `rejected_messages`:
 //! a Hello of another protocol version (1), a device → host or unknown kind (2, detail the kind
-//! byte), a payload that does not parse (3), an unknown WHO_AM_I (4), a perturbation or a batch
+//! byte), a payload that does not parse or images of another length than the chip's (3), a chip
+//! model, identity, image length or I2C address this device cannot emulate (4), a perturbation or a batch
 //! of the other source (5), a model the shared `Marg` refuses or a Configure while running (6),
 //! Start or samples before Configure (7), a second Start while running (9). Samples beyond the
 //! credit limit are answered with Error 8 (detail: the first dropped index, truncated).
@@ -25,7 +26,7 @@
 //! through I2C bypass, restored afterwards) and are not reported as writes.
 //!
 //! **Served reports.** Every instant served is reported in a [`ServedBatch`] (index, scene time,
-//! CRC-32C of the 22-byte image latched, underrun flag), sent once [`SERVED_FLUSH`] entries are
+//! CRC-32C of the image latched, underrun flag), sent once [`SERVED_FLUSH`] entries are
 //! waiting, with every Telemetry, and when serving stops, so the host can check byte for byte
 //! what the chip presented.
 //!
@@ -73,17 +74,20 @@ pub mod setup;
 pub use ring::{Insert, SampleRing};
 
 use margemu_model::sensor::Truth;
+use margemu_protocol::link::{max_images_per_batch, ServedBatch, ServedSample, CRC32C};
 use margemu_protocol::link::{
     Accumulator, Bus, Buses, Capabilities, Configure, Credit, DeviceState, Encoder, ErrorCode,
     ErrorReport, FeedResult, FirmwareVersion, Frame, Hello, HelloAck, Image, Kind, Message, Modes,
     Rate, RegisterWrite, RegisterWriteBatch, Reset, ResetCause, RxStats, SeqTracker, Source, Start,
-    Telemetry, DEVICE_ID_LEN, MAX_IMAGES_PER_BATCH, MAX_WIRE_LEN,
+    Telemetry, DEVICE_ID_LEN, MAX_WIRE_LEN,
 };
-use margemu_protocol::link::{ServedBatch, ServedSample, CRC32C};
 use margemu_protocol::PROTOCOL_VERSION;
 
-use crate::chip::{self, Mpu6xxx};
+use crate::chip::{self, Chip, EmulatedChip};
 use setup::Model;
+
+/// The shortest image of any model (the 6xxx parts without magnetometer).
+const SMALLEST_IMAGE_LEN: usize = 14;
 
 /// Telemetry period when Configure asks for the default (0): 100 ms.
 pub const DEFAULT_TELEMETRY_PERIOD_NS: u64 = 100_000_000;
@@ -150,6 +154,8 @@ struct Session {
     rate: Rate,
     telemetry_period_ns: u64,
     images: bool,
+    /// Bytes per image of the configured chip.
+    image_len: u8,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -168,7 +174,7 @@ pub struct Device<const N: usize = 128> {
 }
 
 struct Core<const N: usize> {
-    chip: Mpu6xxx,
+    chip: EmulatedChip,
     identity: Identity,
     state: DeviceState,
     session: Option<Session>,
@@ -215,7 +221,7 @@ impl<const N: usize> Device<N> {
         Self {
             rx: Accumulator::new(),
             core: Core {
-                chip: Mpu6xxx::new(),
+                chip: EmulatedChip::default(),
                 identity,
                 state: DeviceState::Idle,
                 session: None,
@@ -264,12 +270,12 @@ impl<const N: usize> Device<N> {
     }
 
     /// The emulated chip, for the board's (or the host's) SPI/I2C target.
-    pub fn chip_mut(&mut self) -> &mut Mpu6xxx {
+    pub fn chip_mut(&mut self) -> &mut EmulatedChip {
         &mut self.core.chip
     }
 
     /// The emulated chip.
-    pub fn chip(&self) -> &Mpu6xxx {
+    pub fn chip(&self) -> &EmulatedChip {
         &self.core.chip
     }
 
@@ -306,10 +312,11 @@ impl<const N: usize> Device<N> {
     /// What the device advertises in HelloAck.
     pub fn capabilities() -> Capabilities {
         Capabilities {
-            chips: setup::CHIPS,
+            chips: setup::chips(),
             modes: Modes::IMAGES | Modes::MODEL,
             buses: Buses::SPI | Buses::I2C,
-            max_batch: MAX_IMAGES_PER_BATCH as u16,
+            // The most of the smallest images (14 bytes) a frame holds; longer images fit fewer.
+            max_batch: max_images_per_batch(SMALLEST_IMAGE_LEN) as u16,
             buffer_capacity: u32::try_from(N).unwrap_or(u32::MAX),
         }
     }
@@ -352,6 +359,11 @@ impl<const N: usize> Core<N> {
             Message::Start(s) => self.start(s, seq, now_ns),
             Message::Stop => self.stop(now_ns),
             Message::Images(b) => {
+                let configured = self.session.map(|s| usize::from(s.image_len));
+                if !b.images.is_empty() && configured.is_some_and(|n| n != b.images.image_len()) {
+                    let len = b.images.image_len() as u32;
+                    return self.refuse(ErrorCode::MalformedMessage, seq, len);
+                }
                 let samples = b.images.iter().map(Slot::Image);
                 self.samples(true, b.first_index, samples, seq);
             }
@@ -406,7 +418,7 @@ impl<const N: usize> Core<N> {
         }
         let chip = match setup::build_chip(c) {
             Ok(chip) => chip,
-            Err(code) => return self.refuse(code, seq, u32::from(c.who_am_i)),
+            Err(code) => return self.refuse(code, seq, u32::from(c.chip.code())),
         };
         let model = match &c.source {
             Source::Images => None,
@@ -423,6 +435,7 @@ impl<const N: usize> Core<N> {
             rate: c.rate,
             telemetry_period_ns: period,
             images: model.is_none(),
+            image_len: c.image_len,
         });
         self.chip = chip;
         self.model = model;
@@ -714,7 +727,7 @@ impl<const N: usize> Core<N> {
                 }
                 n += 1;
             }
-            let total = self.chip.write_log().dropped();
+            let total = self.chip.writes_dropped();
             let dropped = total.wrapping_sub(self.writes_dropped_seen);
             if n == 0 && dropped == 0 {
                 return;

@@ -1,9 +1,12 @@
 //! Host-side helpers: encode messages, collect and decode the device's frames, read the chip.
 
+pub use margemu_firmware::chip::EmulatedChip;
 use margemu_firmware::chip::SpiTarget;
 use margemu_firmware::link::Device;
+pub use margemu_protocol::chip::ChipModel;
+pub use margemu_protocol::link::Image;
 use margemu_protocol::link::{
-    Accumulator, Configure, Credit, Encoder, ErrorReport, FeedResult, FrameRepr, HelloAck, Image,
+    Accumulator, Configure, Credit, Encoder, ErrorReport, FeedResult, FrameRepr, HelloAck,
     ImageBatch, Message, Rate, RegisterWrite, ResetCause, ServedSample, Start, Telemetry,
     MAX_WIRE_LEN,
 };
@@ -176,7 +179,7 @@ pub fn image(i: u64) -> Image {
         *byte = (i.wrapping_mul(31).wrapping_add(b as u64 * 7) & 0xFF) as u8;
     }
     im[21] &= 0x18; // ST2: only HOFL and BITM are meaningful
-    im
+    Image::from(im)
 }
 
 pub fn images(first: u64, n: usize) -> Vec<Image> {
@@ -194,7 +197,7 @@ pub fn configured() -> (Dev, Host) {
     let mut dev = Dev::new();
     let mut host = Host::new();
     host.hello(&mut dev, 1);
-    host.configure(&mut dev, Configure::new(0x71, rate_1khz()));
+    host.configure(&mut dev, Configure::new(ChipModel::Mpu9250, rate_1khz()));
     poll(&mut dev, 0);
     (dev, host)
 }

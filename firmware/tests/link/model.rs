@@ -46,7 +46,7 @@ fn model_images_equal_the_hosts_prediction_bit_for_bit() {
         &mut dev,
         Configure {
             source: Source::Model(params),
-            ..Configure::new(0x71, out_rate)
+            ..Configure::new(ChipModel::Mpu9250, out_rate)
         },
     );
     let sent: Vec<Truth> = (0..40).map(truth).collect();
@@ -70,7 +70,7 @@ fn model_images_equal_the_hosts_prediction_bit_for_bit() {
         let expected = ImageRepr::from_physical(s.acc, s.gyr, temp, mag, &cfg).emit();
         let served = dev.last_served().unwrap();
         assert_eq!(served.index, k);
-        assert_eq!(served.image, Some(expected), "sample {k}");
+        assert_eq!(served.image, Some(Image::from(expected)), "sample {k}");
         assert_eq!(served.underrun, k >= 200, "sample {k}");
         assert_eq!(burst_sensors(&mut dev), expected[..14]);
     }
@@ -89,7 +89,7 @@ fn the_model_stops_at_the_scene_end_without_underruns() {
         &mut dev,
         Configure {
             source: Source::Model(params),
-            ..Configure::new(0x71, Rate::hz(1000).unwrap())
+            ..Configure::new(ChipModel::Mpu9250, Rate::hz(1000).unwrap())
         },
     );
     // 40 kinematics at 200 Hz cover 200 outputs at 1 kHz: the scene's 200 samples.

@@ -63,7 +63,7 @@ proptest! {
         let mut dev = Dev::new();
         let mut host = Host::new();
         host.hello(&mut dev, 1);
-        host.configure(&mut dev, Configure::new(0x71, rate_1khz()));
+        host.configure(&mut dev, Configure::new(ChipModel::Mpu9250, rate_1khz()));
         host.start(&mut dev, 0, 0);
         let mut now = 0;
         for (i, chunk) in chunks.iter().enumerate() {

@@ -5,8 +5,8 @@ use margemu_firmware::link::DEFAULT_TELEMETRY_PERIOD_NS;
 use margemu_model::perturbation::PerturbationConfig;
 use margemu_model::sensor::MargConfig;
 use margemu_protocol::link::{
-    Bus, Chips, Configure, Credit, DeviceState, ErrorCode, Message, ModelParams, Modes,
-    RegisterFile, RegisterOverride, ResetCause, Source, Start,
+    Bus, Configure, Credit, DeviceState, ErrorCode, Message, ModelParams, Modes, RegisterOverride,
+    ResetCause, Source, Start,
 };
 
 use crate::common::*;
@@ -24,9 +24,9 @@ fn handshake_answers_with_capabilities_after_the_boot_reset() {
     assert_eq!(ack.session, 0xDEAD_BEEF);
     assert_eq!(ack.protocol_version, margemu_protocol::PROTOCOL_VERSION);
     let caps = ack.capabilities;
-    assert!(caps.chips.contains(Chips::MPU9250 | Chips::MPU6500));
+    assert!(caps.chips.has(ChipModel::Mpu9250) && caps.chips.has(ChipModel::Mpu6500));
     assert!(caps.modes.contains(Modes::IMAGES | Modes::MODEL));
-    assert_eq!((caps.buffer_capacity, caps.max_batch), (CAP as u32, 69));
+    assert_eq!((caps.buffer_capacity, caps.max_batch), (CAP as u32, 108));
     assert_eq!(out.len(), 2, "idle: no credit, no telemetry");
     assert_eq!(poll(&mut dev, 1_000 * MS), vec![]);
 }
@@ -37,17 +37,20 @@ fn configure_grants_the_whole_buffer_and_applies_overrides() {
     let mut host = Host::new();
     host.hello(&mut dev, 1);
     poll(&mut dev, 0);
-    let mut cfg = Configure::new(0x73, rate_1khz());
+    let mut cfg = Configure {
+        who_am_i: 0x73,
+        ..Configure::new(ChipModel::Mpu9250, rate_1khz())
+    };
     cfg.overrides
         .push(RegisterOverride {
-            file: RegisterFile::Mpu9250,
+            file: 0,
             register: 0x1B,
             value: 0x18,
         })
         .unwrap();
     cfg.overrides
         .push(RegisterOverride {
-            file: RegisterFile::Ak8963,
+            file: 1,
             register: 0x0A,
             value: 0x16,
         })
@@ -63,10 +66,13 @@ fn configure_grants_the_whole_buffer_and_applies_overrides() {
         "overrides are not reported as writes of the device under test"
     );
     assert_eq!(dev.state(), DeviceState::Configured);
-    assert_eq!(dev.chip().peek(0x75), 0x73);
-    assert_eq!(dev.chip().peek(0x1B), 0x18);
-    assert_eq!(dev.chip().ak8963().unwrap().peek(0x0A), 0x16);
-    assert_eq!(dev.chip().peek(0x37) & 0x02, 0, "bypass restored");
+    let EmulatedChip::Mpu6xxx(chip) = dev.chip() else {
+        panic!("an MPU-9250 was configured")
+    };
+    assert_eq!(chip.peek(0x75), 0x73);
+    assert_eq!(chip.peek(0x1B), 0x18);
+    assert_eq!(chip.ak8963().unwrap().peek(0x0A), 0x16);
+    assert_eq!(chip.peek(0x37) & 0x02, 0, "bypass restored");
 }
 
 #[test]
@@ -76,14 +82,20 @@ fn refusals_are_answered_and_counted() {
     host.hello(&mut dev, 1);
     poll(&mut dev, 0);
     host.send(&mut dev, &Message::Start(Start::until_stop(0)), 0);
-    host.configure(&mut dev, Configure::new(0x42, rate_1khz()));
+    host.configure(
+        &mut dev,
+        Configure {
+            who_am_i: 0x42,
+            ..Configure::new(ChipModel::Mpu9250, rate_1khz())
+        },
+    );
     let mut p = ModelParams::new(1, rate_1khz(), MargConfig::default());
     p.perturbation = Some(PerturbationConfig::default());
     host.configure(
         &mut dev,
         Configure {
             source: Source::Model(p),
-            ..Configure::new(0x71, rate_1khz())
+            ..Configure::new(ChipModel::Mpu9250, rate_1khz())
         },
     );
     let out = poll(&mut dev, 0);
@@ -104,6 +116,70 @@ fn refusals_are_answered_and_counted() {
     );
     assert_eq!(dev.counters().rx.rejected_messages, 3);
     assert_eq!(dev.state(), DeviceState::Idle);
+}
+
+/// Every chip the device cannot serve as asked is refused with UnsupportedChip (detail: the
+/// model's code), and images of another length than the configured chip's are malformed.
+#[test]
+fn chips_identities_image_lengths_and_addresses_are_checked() {
+    let mut dev = Dev::new();
+    let mut host = Host::new();
+    host.hello(&mut dev, 1);
+    poll(&mut dev, 0);
+    let mpu = Configure::new(ChipModel::Mpu9250, rate_1khz());
+    let refused = [
+        Configure {
+            who_am_i: 0x47,
+            ..mpu.clone()
+        },
+        Configure {
+            image_len: 32,
+            ..mpu.clone()
+        },
+        Configure {
+            i2c_address: 0x0C,
+            ..mpu.clone()
+        },
+        Configure {
+            overrides: [RegisterOverride {
+                file: 5,
+                register: 0,
+                value: 0,
+            }]
+            .into_iter()
+            .collect(),
+            ..mpu.clone()
+        },
+    ];
+    for cfg in refused {
+        host.configure(&mut dev, cfg);
+    }
+    let mut out = poll(&mut dev, 0); // at most four errors wait between polls
+    let six = Configure::new(ChipModel::Mpu6500, rate_1khz());
+    assert_eq!(usize::from(six.image_len), 14);
+    host.configure(&mut dev, six);
+    host.images(&mut dev, 0, &[Image::from([0u8; 22])], 0);
+    host.images(&mut dev, 0, &[Image::from([0u8; 14])], 0);
+    out.extend(poll(&mut dev, 0));
+    let codes: Vec<_> = out
+        .iter()
+        .filter_map(|o| match o {
+            Out::Error(e) => Some((e.code, e.detail)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        codes,
+        vec![
+            (ErrorCode::UnsupportedChip, 0),
+            (ErrorCode::UnsupportedChip, 0),
+            (ErrorCode::UnsupportedChip, 0),
+            (ErrorCode::InvalidConfig, 0),
+            (ErrorCode::MalformedMessage, 22),
+        ]
+    );
+    assert_eq!(dev.state(), DeviceState::Configured);
+    assert_eq!(dev.buffer_level(), 1, "the 14-byte image was taken");
 }
 
 #[test]

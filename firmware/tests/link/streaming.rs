@@ -199,7 +199,10 @@ fn start_time_picks_the_first_instant_and_rational_rates_are_exact() {
     let mut host = Host::new();
     host.hello(&mut dev, 1);
     let rate = margemu_protocol::link::Rate::new(1000, 3).unwrap();
-    host.configure(&mut dev, margemu_protocol::link::Configure::new(0x71, rate));
+    host.configure(
+        &mut dev,
+        margemu_protocol::link::Configure::new(ChipModel::Mpu9250, rate),
+    );
     host.images(&mut dev, 0, &images(0, 20), 0);
     host.start(&mut dev, 4_000_000, 0); // first instant ≥ 4 ms: k = 2 at 6 ms
     poll(&mut dev, 1_999_999);

@@ -42,6 +42,7 @@
 //! ```
 
 mod aux_master;
+mod boundary;
 mod fifo;
 mod i2c;
 mod registers;
@@ -282,13 +283,18 @@ impl Mpu6xxx {
     }
 
     /// Latches one finished register image taken at `now_ns` (source mode (a)); see
-    /// [`margemu_protocol::regmap::mpu6xxx::image`] for the layout.
-    pub fn latch_image_at(&mut self, image: &[u8; IMAGE_LEN], now_ns: u64) {
-        self.latch_registers(image, now_ns);
+    /// [`margemu_protocol::regmap::mpu6xxx::image`] for the layout. A shorter image (the 14
+    /// sensor bytes of a part without magnetometer) is zero-padded; bytes beyond
+    /// [`IMAGE_LEN`] are ignored.
+    pub fn latch_image_at(&mut self, image: &[u8], now_ns: u64) {
+        let mut full = [0u8; IMAGE_LEN];
+        let n = image.len().min(IMAGE_LEN);
+        full[..n].copy_from_slice(&image[..n]);
+        self.latch_registers(&full, now_ns);
     }
 
     /// Latches one register image at the next instant of the chip's sample clock.
-    pub fn latch_image(&mut self, image: &[u8; IMAGE_LEN]) {
+    pub fn latch_image(&mut self, image: &[u8]) {
         self.latch_image_at(image, self.next_sample_ns());
     }
 

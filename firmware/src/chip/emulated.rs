@@ -1,0 +1,203 @@
+//! The chip boundary on the device: [`Chip`], the one face every emulated chip shows to the link
+//! handler, the SPI shadow, the boards and the host's virtual flight controller, and
+//! [`EmulatedChip`], the chip a device runs, chosen by [`Configure`](margemu_protocol::link::Configure).
+//!
+//! Nothing outside a chip's module names a register: the link latches images and physical
+//! samples, the boards ask for the INT level, the SPI shadow asks what a bus read would return,
+//! register overrides are applied by the chip through its own bus.
+//!
+//! ```
+//! use margemu_firmware::chip::{Chip, EmulatedChip, PhysicalSample};
+//! use margemu_protocol::chip::ChipModel;
+//! let mut chip = EmulatedChip::new(ChipModel::Mpu9250, 0x71, 0x68).unwrap();
+//! let at_rest = PhysicalSample { acc: [0.0, 0.0, 9.80665], temp_c: 21.0, ..Default::default() };
+//! let image = chip.settings().image(&at_rest);
+//! chip.latch_image_at(&image, 1_000_000);
+//! assert_eq!(chip.model(), ChipModel::Mpu9250);
+//! assert!(EmulatedChip::new(ChipModel::Mpu9250, 0x47, 0x68).is_none()); // not its identity
+//! ```
+
+use margemu_protocol::chip::{ChipModel, ChipSettings, PhysicalSample};
+
+use super::mpu6xxx::{self, Mpu6xxx, Variant};
+use super::{I2cTarget, RegisterWrite, SpiTarget};
+
+/// What every emulated chip does for the link, the boards and the host (see the module docs).
+/// Time is the scene time in ns, moved forward only by latches and [`Chip::advance`].
+pub trait Chip: SpiTarget + I2cTarget {
+    /// The model.
+    fn model(&self) -> ChipModel;
+    /// The conversion settings in force now (what a physical sample latched now becomes).
+    fn settings(&self) -> ChipSettings;
+    /// Latches a finished register image of [`ChipModel::image_len`] bytes taken at `now_ns`.
+    fn latch_image_at(&mut self, image: &[u8], now_ns: u64);
+    /// Latches a physical sample (chip axes) taken at `now_ns`.
+    fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64);
+    /// Moves the chip's clock to `now_ns` without a sample.
+    fn advance(&mut self, now_ns: u64);
+    /// The chip's clock.
+    fn now_ns(&self) -> u64;
+    /// Nanoseconds between samples under the chip's current rate registers.
+    fn sample_period_ns(&self) -> u64;
+    /// The electrical level of the (first) interrupt pin at `now_ns` (`true` = high).
+    fn int_pin_at(&self, now_ns: u64) -> bool;
+    /// Whether that pin is open drain.
+    fn int_open_drain(&self) -> bool;
+    /// When the current interrupt pulse ends, for a board to schedule the edge.
+    fn int_pulse_end_ns(&self) -> Option<u64>;
+    /// The oldest register write of the device under test not yet taken.
+    fn pop_write(&mut self) -> Option<RegisterWrite>;
+    /// Writes the write log lost because nobody took them, cumulative.
+    fn writes_dropped(&self) -> u32;
+    /// Writes `value` to `register` of register file `file` (numbered as
+    /// [`ChipModel::register_files`] says) through the chip's own bus, as a driver would;
+    /// `false` if the model has no such file. The write lands in the write log.
+    fn write_register(&mut self, file: u8, register: u8, value: u8) -> bool;
+    /// The chip's 7-bit I2C address.
+    fn i2c_address(&self) -> u8;
+    /// What an SPI read of `addr` would return now, without its side effects (in the register
+    /// bank selected now, for chips with banks).
+    fn spi_peek(&self, addr: u8) -> u8;
+    /// The address an SPI burst moves to after `addr` (the same one for FIFO ports).
+    fn spi_next_address(&self, addr: u8) -> u8;
+    /// What an SPI read of `addr` returns after an SPI write of `value` to it, when the write
+    /// only stores a value (through the write mask); `None` when the write does more (resets,
+    /// FIFO pushes, bank switches, transfers) or nothing: a board's shadow must then wait for
+    /// the chip.
+    fn spi_plain_write(&self, addr: u8, value: u8) -> Option<u8>;
+    /// The register where drivers start their sample burst: the SPI shadow's first guess.
+    fn burst_start(&self) -> u8;
+}
+
+/// The chip a device runs: one variant per chip family, chosen at run time by Configure.
+#[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)] // held once per device; no alloc
+pub enum EmulatedChip {
+    /// The InvenSense 6xxx family (MPU-9250 with its AK8963, MPU-6500, MPU-6000, ICM-20602).
+    Mpu6xxx(Mpu6xxx),
+}
+
+impl Default for EmulatedChip {
+    /// An MPU-9250 at power-on (the default chip).
+    fn default() -> Self {
+        Self::Mpu6xxx(Mpu6xxx::new())
+    }
+}
+
+impl EmulatedChip {
+    /// A chip of `model` answering `who_am_i` at I2C address `i2c_address`, just powered on;
+    /// `None` if the model is not emulated here, or lacks that identity or address.
+    pub fn new(model: ChipModel, who_am_i: u8, i2c_address: u8) -> Option<Self> {
+        if !model.identities().contains(&who_am_i) || !model.i2c_addresses().contains(&i2c_address)
+        {
+            return None;
+        }
+        let ad0 = model.i2c_addresses().get(1) == Some(&i2c_address);
+        let variant = Variant::for_model(model, who_am_i)?;
+        Some(Self::Mpu6xxx(Mpu6xxx::with_config(mpu6xxx::Config {
+            variant,
+            ad0,
+            ..mpu6xxx::Config::default()
+        })))
+    }
+
+    /// The models this firmware emulates.
+    pub fn models() -> impl Iterator<Item = ChipModel> {
+        ChipModel::ALL
+            .into_iter()
+            .filter(|m| Variant::for_model(*m, m.who_am_i()).is_some())
+    }
+}
+
+/// Forwards a method call to the chip inside every variant.
+macro_rules! each_chip {
+    ($self:expr, $chip:ident => $call:expr) => {
+        match $self {
+            EmulatedChip::Mpu6xxx($chip) => $call,
+        }
+    };
+}
+
+impl SpiTarget for EmulatedChip {
+    fn select(&mut self) -> u8 {
+        each_chip!(self, c => c.select())
+    }
+    fn exchange(&mut self, mosi: u8) -> u8 {
+        each_chip!(self, c => c.exchange(mosi))
+    }
+    fn deselect(&mut self) {
+        each_chip!(self, c => c.deselect())
+    }
+}
+
+impl I2cTarget for EmulatedChip {
+    fn start(&mut self, address: u8, read: bool) -> bool {
+        each_chip!(self, c => c.start(address, read))
+    }
+    fn write(&mut self, byte: u8) -> bool {
+        each_chip!(self, c => I2cTarget::write(c, byte))
+    }
+    fn read(&mut self) -> u8 {
+        each_chip!(self, c => I2cTarget::read(c))
+    }
+    fn stop(&mut self) {
+        each_chip!(self, c => c.stop())
+    }
+}
+
+impl Chip for EmulatedChip {
+    fn model(&self) -> ChipModel {
+        each_chip!(self, c => c.model())
+    }
+    fn settings(&self) -> ChipSettings {
+        each_chip!(self, c => c.settings())
+    }
+    fn latch_image_at(&mut self, image: &[u8], now_ns: u64) {
+        each_chip!(self, c => Chip::latch_image_at(c, image, now_ns))
+    }
+    fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64) {
+        each_chip!(self, c => Chip::latch_at(c, sample, now_ns))
+    }
+    fn advance(&mut self, now_ns: u64) {
+        each_chip!(self, c => Chip::advance(c, now_ns))
+    }
+    fn now_ns(&self) -> u64 {
+        each_chip!(self, c => Chip::now_ns(c))
+    }
+    fn sample_period_ns(&self) -> u64 {
+        each_chip!(self, c => Chip::sample_period_ns(c))
+    }
+    fn int_pin_at(&self, now_ns: u64) -> bool {
+        each_chip!(self, c => Chip::int_pin_at(c, now_ns))
+    }
+    fn int_open_drain(&self) -> bool {
+        each_chip!(self, c => Chip::int_open_drain(c))
+    }
+    fn int_pulse_end_ns(&self) -> Option<u64> {
+        each_chip!(self, c => Chip::int_pulse_end_ns(c))
+    }
+    fn pop_write(&mut self) -> Option<RegisterWrite> {
+        each_chip!(self, c => Chip::pop_write(c))
+    }
+    fn writes_dropped(&self) -> u32 {
+        each_chip!(self, c => c.writes_dropped())
+    }
+    fn write_register(&mut self, file: u8, register: u8, value: u8) -> bool {
+        each_chip!(self, c => c.write_register(file, register, value))
+    }
+    fn i2c_address(&self) -> u8 {
+        each_chip!(self, c => Chip::i2c_address(c))
+    }
+    fn spi_peek(&self, addr: u8) -> u8 {
+        each_chip!(self, c => c.spi_peek(addr))
+    }
+    fn spi_next_address(&self, addr: u8) -> u8 {
+        each_chip!(self, c => c.spi_next_address(addr))
+    }
+    fn spi_plain_write(&self, addr: u8, value: u8) -> Option<u8> {
+        each_chip!(self, c => c.spi_plain_write(addr, value))
+    }
+    fn burst_start(&self) -> u8 {
+        each_chip!(self, c => c.burst_start())
+    }
+}
