@@ -1,5 +1,6 @@
 //! Link throughput: encode + frame + COBS, and accumulate + verify + parse, of a batch of 32
-//! register images; prints the link-efficiency table first.
+//! MPU-9250 register images (22 bytes); prints the link-efficiency table of every image length
+//! first.
 //!
 //! `cargo bench -p margemu-protocol --bench link`
 
@@ -9,30 +10,43 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use margemu_protocol::chip::ChipModel;
 use margemu_protocol::link::{
-    image_batch_efficiency, image_batch_wire_len, Accumulator, Encoder, FeedResult, FrameRepr,
-    ImageBatch, Message, IMAGE_LEN, MAX_WIRE_LEN,
+    image_batch_efficiency, image_batch_wire_len, max_images_per_batch, Accumulator, Encoder,
+    FeedResult, FrameRepr, Image, ImageBatch, Message, MAX_WIRE_LEN,
 };
 
 const BATCH: usize = 32;
+const IMAGE_LEN: usize = ChipModel::Mpu9250.image_len();
 
-fn images() -> Vec<[u8; IMAGE_LEN]> {
+fn images() -> Vec<Image> {
     // Register-like content: small values with zero bytes, so COBS does real work.
     (0..BATCH)
-        .map(|i| core::array::from_fn(|k| ((i * 31 + k * 7) % 251) as u8))
+        .map(|i| {
+            let bytes: [u8; IMAGE_LEN] = core::array::from_fn(|k| ((i * 31 + k * 7) % 251) as u8);
+            Image::from(bytes)
+        })
         .collect()
 }
 
 fn print_efficiency_table() {
-    println!("image batches, worst case (COBS ⌈n/254⌉, two 0x00, 6 B header, 8 B index, 4 B CRC):");
     println!(
-        "{:>6} {:>11} {:>10} {:>11}",
-        "images", "image bytes", "wire bytes", "efficiency"
+        "image batches, worst case (COBS ⌈n/254⌉, two 0x00, 6 B header, 8 B index, 1 B image \
+         length, 4 B CRC):"
     );
-    for n in [1, 8, 16, 32, 64] {
-        let (payload, wire) = (n * IMAGE_LEN, image_batch_wire_len(n));
-        let e = 100.0 * image_batch_efficiency(n);
-        println!("{n:>6} {payload:>11} {wire:>10} {e:>10.1} %");
+    println!(
+        "{:>6} {:>6} {:>11} {:>10} {:>11}",
+        "length", "images", "image bytes", "wire bytes", "efficiency"
+    );
+    for len in [14, 22, 32] {
+        for n in [1, 8, 16, 32, 64]
+            .into_iter()
+            .filter(|&n| n <= max_images_per_batch(len))
+        {
+            let (payload, wire) = (n * len, image_batch_wire_len(n, len));
+            let e = 100.0 * image_batch_efficiency(n, len);
+            println!("{len:>6} {n:>6} {payload:>11} {wire:>10} {e:>10.1} %");
+        }
     }
 }
 

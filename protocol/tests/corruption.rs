@@ -5,12 +5,13 @@
 mod common;
 
 use common::*;
+use margemu_protocol::chip::ChipModel;
 use margemu_protocol::link::*;
 use proptest::prelude::*;
 
 /// Three frames A, B, C: B is the victim.
 fn abc() -> (Vec<u8>, Vec<u8>, Vec<u8>) {
-    let images = [[0x5Au8; IMAGE_LEN], [0x00; IMAGE_LEN], [0xA5; IMAGE_LEN]];
+    let images = [[0x5Au8; 22], [0x00; 22], [0xA5; 22]].map(Image::from);
     let a = wire(1, &Message::Start(Start::until_stop(7)));
     let b = wire(2, &Message::Images(ImageBatch::new(1 << 40, &images)));
     let c = wire(
@@ -132,20 +133,27 @@ fn an_oversized_frame_is_dropped_up_to_its_delimiter() {
 
 #[test]
 fn a_largest_frame_fits_the_accumulator_in_the_worst_case() {
-    // No zero byte at all: COBS overhead is at its maximum.
-    let images = [[0x77u8; IMAGE_LEN]; MAX_IMAGES_PER_BATCH];
-    let msg = Message::Images(ImageBatch::new(u64::MAX, &images));
-    let bytes = wire(0xFFFF, &msg);
-    assert!(bytes.len() <= MAX_WIRE_LEN);
-    assert_eq!(frame_of(&bytes), Outcome::Frame(frame(0xFFFF, &msg)));
-    let mut too_many = [[0x77u8; IMAGE_LEN]; MAX_IMAGES_PER_BATCH + 1].to_vec();
-    too_many[0][0] = 1;
-    let msg = Message::Images(ImageBatch::new(0, &too_many));
-    let mut out = [0u8; MAX_WIRE_LEN];
-    assert_eq!(
-        Encoder::new().encode(&msg, &mut out),
-        Err(Error::MessageTooLarge)
-    );
+    // No zero byte at all: COBS overhead is at its maximum. Every model's image length, and
+    // 1-byte images, which fill the payload to its last byte (1517 images, a 1536-byte frame).
+    let lengths = ChipModel::ALL.map(|m| m.image_len());
+    for len in lengths.into_iter().chain([1]) {
+        let n = max_images_per_batch(len);
+        let images = vec![Image::new(&vec![0x77u8; len]).unwrap(); n];
+        let msg = Message::Images(ImageBatch::new(u64::MAX, &images));
+        let bytes = wire(0xFFFF, &msg);
+        assert!(bytes.len() <= MAX_WIRE_LEN, "{len}");
+        assert_eq!(bytes.len(), image_batch_wire_len(n, len), "{len}");
+        assert_eq!(frame_of(&bytes), Outcome::Frame(frame(0xFFFF, &msg)));
+        let mut too_many = vec![images[0]; n + 1];
+        too_many[0].as_mut_bytes()[0] = 1;
+        let msg = Message::Images(ImageBatch::new(0, &too_many));
+        let mut out = [0u8; MAX_WIRE_LEN];
+        assert_eq!(
+            Encoder::new().encode(&msg, &mut out),
+            Err(Error::MessageTooLarge),
+            "{len}"
+        );
+    }
 }
 
 #[test]

@@ -5,6 +5,7 @@ mod common;
 use common::payload;
 use margemu_model::perturbation::{Amplitude, PerturbationConfig, Placement};
 use margemu_model::sensor::{MargConfig, Truth};
+use margemu_protocol::chip::ChipModel;
 use margemu_protocol::link::*;
 
 fn parses_back(kind: Kind, bytes: &[u8], message: &Message<'_>) {
@@ -23,7 +24,7 @@ fn hello_ack() {
         },
         device_id: core::array::from_fn(|i| 0xA0 + i as u8),
         capabilities: Capabilities {
-            chips: Chips::MPU9250 | Chips::WHO_AM_I_68,
+            chips: Chips::of(ChipModel::Mpu9250) | Chips::of(ChipModel::Mpu6000),
             modes: Modes::IMAGES | Modes::MODEL,
             buses: Buses::SPI,
             max_batch: 0x0B0A,
@@ -31,13 +32,49 @@ fn hello_ack() {
         },
     });
     let b = payload(&m);
-    assert_eq!(b.len(), 34);
+    assert_eq!((b.len(), HelloAck::LEN), (37, 37));
     assert_eq!(b[..9], [0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 7, 8, 9]);
     assert_eq!((b[9], b[24]), (0xA0, 0xAF));
+    // chips: u32, bit n = model code n (MPU-9250 0, MPU-6000 2); modes; buses; max_batch; capacity.
     assert_eq!(
         b[25..],
-        [0x09, 0x03, 0x01, 0x0A, 0x0B, 0x0C, 0x0D, 0x0E, 0x0F]
+        [0x05, 0, 0, 0, 0x03, 0x01, 0x0A, 0x0B, 0x0C, 0x0D, 0x0E, 0x0F]
     );
+    parses_back(Kind::HelloAck, &b, &m);
+}
+
+#[test]
+fn chips_are_a_set_of_model_codes() {
+    for model in ChipModel::ALL {
+        assert_eq!(Chips::of(model), Chips(1 << model.code()));
+        assert!(Chips::of(model).has(model));
+        assert_eq!(Chips::of(model).models().collect::<Vec<_>>(), [model]);
+    }
+    let all = ChipModel::ALL
+        .into_iter()
+        .fold(Chips::EMPTY, |c, m| c | Chips::of(m));
+    assert_eq!(all, Chips(0x1F));
+    assert!(all.models().eq(ChipModel::ALL));
+    // Unknown bits (a newer device's models) are kept on the wire and skipped by `models`.
+    let newer = Chips(0x8000_0000 | Chips::of(ChipModel::Icm42688p).0);
+    assert_eq!(newer.models().collect::<Vec<_>>(), [ChipModel::Icm42688p]);
+    let m = Message::HelloAck(HelloAck {
+        protocol_version: margemu_protocol::PROTOCOL_VERSION,
+        session: 0,
+        firmware: FirmwareVersion {
+            major: 0,
+            minor: 0,
+            patch: 0,
+        },
+        device_id: [0; DEVICE_ID_LEN],
+        capabilities: Capabilities {
+            chips: newer,
+            ..Capabilities::default()
+        },
+    });
+    let b = payload(&m);
+    assert_eq!((b[0], b[1]), (3, 0));
+    assert_eq!(b[25..29], [0x10, 0, 0, 0x80]);
     parses_back(Kind::HelloAck, &b, &m);
 }
 
@@ -174,15 +211,17 @@ fn configure_with_the_model() {
     });
     let cfg = Configure {
         source: Source::Model(params),
-        ..Configure::new(0x73, Rate::new(1000, 3).unwrap())
+        who_am_i: 0x73,
+        ..Configure::new(ChipModel::Mpu9250, Rate::new(1000, 3).unwrap())
     };
     let m = Message::Configure(cfg);
     let b = payload(&m);
+    // chip 0 (MPU-9250) answering 0x73 (MPU-9255), 22-byte images, I2C 0x68; then source 1.
     assert_eq!(
-        b[..19],
-        [0x73, 1, 0xE8, 0x03, 0, 0, 3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]
+        b[..22],
+        [0, 0x73, 22, 0x68, 1, 0xE8, 0x03, 0, 0, 3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]
     );
-    let p = &b[19..];
+    let p = &b[22..];
     assert_eq!(
         p[..16],
         [0x2A, 0, 0, 0, 0, 0, 0, 0, 200, 0, 0, 0, 1, 0, 0, 0]
@@ -204,7 +243,7 @@ fn configure_with_the_model() {
     parses_back(Kind::Configure, &b, &m);
     // A reserved mask bit, or hard iron on the gyroscope, is refused.
     let mut bad = b.clone();
-    bad[19 + 25] = 0x04;
+    bad[22 + 25] = 0x04;
     assert_eq!(Message::parse(0x02, &bad), Err(Error::InvalidValue));
 }
 
@@ -242,20 +281,180 @@ fn largest_configure_fits_a_frame() {
     });
     let mut cfg = Configure {
         source: Source::Model(params),
-        ..Configure::new(0x71, Rate::hz(1).unwrap())
+        ..Configure::new(ChipModel::Mpu9250, Rate::hz(1).unwrap())
     };
     let o = RegisterOverride {
-        file: RegisterFile::Ak8963,
+        file: 1, // the MPU-9250's AK8963
         register: 0x10,
         value: 0x80,
     };
     while cfg.overrides.push(o).is_ok() {}
     let m = Message::Configure(cfg);
     assert_eq!(m.buffer_len(), MAX_CONFIGURE_LEN);
-    assert_eq!((MAX_CONFIGURE_LEN, MAX_MARG_CONFIG_LEN), (1396, 1182));
+    assert_eq!((MAX_CONFIGURE_LEN, MAX_MARG_CONFIG_LEN), (1399, 1182));
     let b = payload(&m);
     parses_back(Kind::Configure, &b, &m);
     let mut bad = b.clone();
-    bad[18] = 33;
+    bad[21] = 33;
     assert_eq!(Message::parse(0x02, &bad), Err(Error::InvalidValue));
+}
+
+#[test]
+fn configure_names_the_chip() {
+    let rate = Rate::hz(1000).unwrap();
+    for model in ChipModel::ALL {
+        let cfg = Configure::new(model, rate);
+        assert_eq!(
+            (cfg.chip, cfg.who_am_i, usize::from(cfg.image_len)),
+            (model, model.identities()[0], model.image_len())
+        );
+        assert_eq!(cfg.i2c_address, model.i2c_addresses()[0]);
+        let m = Message::Configure(cfg);
+        let b = payload(&m);
+        assert_eq!(b.len(), 22);
+        assert_eq!(
+            b[..5],
+            [
+                model.code(),
+                model.who_am_i(),
+                model.image_len() as u8,
+                0x68,
+                0
+            ]
+        );
+        parses_back(Kind::Configure, &b, &m);
+    }
+    assert_eq!(
+        ChipModel::ALL.map(|m| (m.code(), m.image_len())),
+        [(0, 22), (1, 14), (2, 14), (3, 14), (4, 32)]
+    );
+    // Identity, image length and address are carried as they are (the device judges them);
+    // an override's file is a plain byte numbered by the model.
+    let mut cfg = Configure::new(ChipModel::Icm42688p, rate);
+    (cfg.who_am_i, cfg.image_len, cfg.i2c_address) = (0x71, 22, 0x0C);
+    let o = RegisterOverride {
+        file: 4,
+        register: 0x7B,
+        value: 0x02,
+    };
+    cfg.overrides.push(o).unwrap();
+    let m = Message::Configure(cfg);
+    let b = payload(&m);
+    assert_eq!(b[..5], [4, 0x71, 22, 0x0C, 0]);
+    assert_eq!(b[21..], [1, 4, 0x7B, 0x02]);
+    parses_back(Kind::Configure, &b, &m);
+    // An unknown chip code is refused.
+    for code in [5, 0x80, 0xFF] {
+        let mut bad = b.clone();
+        bad[0] = code;
+        assert_eq!(
+            Message::parse(0x02, &bad),
+            Err(Error::InvalidValue),
+            "{code}"
+        );
+    }
+}
+
+#[test]
+fn image_batch() {
+    assert_eq!(IMAGE_BATCH_HEADER_LEN, 9);
+    for model in ChipModel::ALL {
+        let len = model.image_len();
+        let images: Vec<Image> = (0..3u8)
+            .map(|k| Image::new(&vec![0x10 * (k + 1); len]).unwrap())
+            .collect();
+        let m = Message::Images(ImageBatch::new(0x0102, &images));
+        let b = payload(&m);
+        assert_eq!(b.len(), IMAGE_BATCH_HEADER_LEN + 3 * len, "{model:?}");
+        assert_eq!(b[..9], [0x02, 0x01, 0, 0, 0, 0, 0, 0, len as u8]);
+        assert!(b[9..9 + len].iter().all(|&x| x == 0x10));
+        assert!(b[9 + 2 * len..].iter().all(|&x| x == 0x30));
+        parses_back(Kind::Images, &b, &m);
+        let Ok(Message::Images(batch)) = Message::parse(0x10, &b) else {
+            panic!("{model:?}")
+        };
+        assert_eq!(
+            (batch.images.len(), batch.images.image_len()),
+            (3, len),
+            "{model:?}"
+        );
+        assert_eq!(batch.images.get(2), Some(images[2]));
+        assert_eq!(batch.images.get(3), None);
+    }
+    // No image: length byte 0.
+    let m = Message::Images(ImageBatch::new(5, &[]));
+    let b = payload(&m);
+    assert_eq!(b, [5, 0, 0, 0, 0, 0, 0, 0, 0]);
+    parses_back(Kind::Images, &b, &m);
+}
+
+#[test]
+fn image_batch_refusals() {
+    let index = [7u8, 0, 0, 0, 0, 0, 0, 0];
+    let parse = |len: u8, images: &[u8]| {
+        let b = [&index[..], &[len], images].concat();
+        Message::parse(Kind::Images as u8, &b).map(|m| m.buffer_len())
+    };
+    assert_eq!(parse(0, &[]), Ok(9));
+    assert_eq!(parse(32, &[0x20; 64]), Ok(73));
+    assert_eq!(parse(1, &[0x01; 3]), Ok(12));
+    // Length 0 with images, above 32, or not dividing the images' bytes.
+    assert_eq!(parse(0, &[1]), Err(Error::InvalidValue));
+    assert_eq!(parse(0, &[0; 22]), Err(Error::InvalidValue));
+    assert_eq!(parse(33, &[0; 33]), Err(Error::InvalidValue));
+    assert_eq!(parse(33, &[]), Err(Error::InvalidValue));
+    assert_eq!(parse(0xFF, &[0; 255]), Err(Error::InvalidValue));
+    assert_eq!(parse(22, &[0; 23]), Err(Error::PayloadTooLong));
+    assert_eq!(parse(22, &[0; 14]), Err(Error::PayloadTooLong));
+    assert_eq!(parse(14, &[0; 22]), Err(Error::PayloadTooLong));
+    // No length byte at all.
+    assert_eq!(
+        Message::parse(Kind::Images as u8, &index),
+        Err(Error::PayloadTooShort)
+    );
+}
+
+#[test]
+fn image_batch_of_mixed_lengths_is_not_emitted() {
+    let (a, b) = (Image::from([1u8; 22]), Image::from([2u8; 14]));
+    let c = Image::from([3u8; 32]);
+    let mut wire = [0u8; MAX_WIRE_LEN];
+    let mut buf = [0u8; MAX_PAYLOAD_LEN];
+    for mixed in [[a, b], [b, a], [a, c], [c, a]] {
+        let m = Message::Images(ImageBatch::new(0, &mixed));
+        assert_eq!(m.emit(&mut buf), Err(Error::InvalidValue), "{mixed:?}");
+        assert_eq!(
+            Encoder::new().encode(&m, &mut wire),
+            Err(Error::InvalidValue),
+            "{mixed:?}"
+        );
+    }
+    // Nor a batch of empty images (the wire says "no image" with length 0).
+    let empty = [Image::default(); 2];
+    let m = Message::Images(ImageBatch::new(0, &empty));
+    assert_eq!(m.emit(&mut buf), Err(Error::InvalidValue));
+}
+
+#[test]
+fn images_per_batch_by_length() {
+    // (1526 − 9) / image length.
+    let expected = [(1, 1517), (14, 108), (22, 68), (32, 47)];
+    for (len, n) in expected {
+        assert_eq!(max_images_per_batch(len), n, "{len}");
+        let images = vec![Image::new(&vec![0x77; len]).unwrap(); n + 1];
+        let fits = Message::Images(ImageBatch::new(0, &images[..n]));
+        assert!(fits.buffer_len() <= MAX_PAYLOAD_LEN);
+        let mut wire = [0u8; MAX_WIRE_LEN];
+        assert!(Encoder::new().encode(&fits, &mut wire).is_ok(), "{len}");
+        let over = Message::Images(ImageBatch::new(0, &images));
+        assert!(over.buffer_len() > MAX_PAYLOAD_LEN);
+        assert_eq!(
+            Encoder::new().encode(&over, &mut wire),
+            Err(Error::MessageTooLarge),
+            "{len}"
+        );
+    }
+    for model in ChipModel::ALL {
+        assert!(max_images_per_batch(model.image_len()) >= 47);
+    }
 }

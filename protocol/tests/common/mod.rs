@@ -7,6 +7,7 @@ use margemu_model::sensor::{
     AccelConfig, BiasInstability, GyroConfig, MagConfig, MargConfig, SensorErrors, TemperatureBias,
     Truth,
 };
+use margemu_protocol::chip::ChipModel;
 use margemu_protocol::link::*;
 use proptest::prelude::*;
 
@@ -115,13 +116,36 @@ pub fn rate() -> impl Strategy<Value = Rate> {
     (1..=u32::MAX, 1..=u32::MAX).prop_map(|(n, d)| Rate::new(n, d).unwrap())
 }
 
+/// Every chip model.
+pub fn chip_model() -> impl Strategy<Value = ChipModel> {
+    prop::sample::select(ChipModel::ALL.to_vec())
+}
+
+/// An image of `len` bytes (≤ [`MAX_IMAGE_LEN`]) of any content.
+pub fn image(len: usize) -> impl Strategy<Value = Image> {
+    prop::collection::vec(any::<u8>(), len).prop_map(|b| Image::new(&b).unwrap())
+}
+
+/// The image length of a batch: every model's, and any other from 1 to [`MAX_IMAGE_LEN`].
+pub fn image_len() -> impl Strategy<Value = usize> {
+    prop_oneof![chip_model().prop_map(|m| m.image_len()), 1..=MAX_IMAGE_LEN,]
+}
+
+/// Images of one length, as many as fit a batch.
+pub fn images() -> impl Strategy<Value = Vec<Image>> {
+    image_len()
+        .prop_flat_map(|len| prop::collection::vec(image(len), 0..=max_images_per_batch(len)))
+}
+
 pub fn configure() -> impl Strategy<Value = Configure> {
-    let over =
-        (0..2u8, any::<u8>(), any::<u8>()).prop_map(|(f, register, value)| RegisterOverride {
-            file: RegisterFile::from_u8(f).unwrap(),
+    // The link carries any file, identity, image length and address; the device judges them.
+    let over = (any::<u8>(), any::<u8>(), any::<u8>()).prop_map(|(file, register, value)| {
+        RegisterOverride {
+            file,
             register,
             value,
-        });
+        }
+    });
     let model = (
         any::<u64>(),
         rate(),
@@ -140,9 +164,19 @@ pub fn configure() -> impl Strategy<Value = Configure> {
         );
     let source = prop_oneof![Just(Source::Images), model.prop_map(Source::Model)];
     let overrides = prop::collection::vec(over, 0..=MAX_OVERRIDES);
-    (any::<u8>(), rate(), any::<u64>(), overrides, source).prop_map(
-        |(who_am_i, rate, telemetry_period_ns, overrides, source)| Configure {
+    let chip = (chip_model(), any::<[u8; 3]>());
+    (chip, rate(), any::<u64>(), overrides, source).prop_map(
+        |(
+            (chip, [who_am_i, image_len, i2c_address]),
+            rate,
+            telemetry_period_ns,
+            overrides,
+            source,
+        )| Configure {
+            chip,
             who_am_i,
+            image_len,
+            i2c_address,
             rate,
             telemetry_period_ns,
             overrides: overrides.into_iter().collect(),
@@ -180,10 +214,10 @@ pub fn hello_ack() -> impl Strategy<Value = HelloAck> {
             any::<[u8; 3]>(),
             any::<[u8; DEVICE_ID_LEN]>(),
         ),
-        (any::<[u8; 3]>(), any::<u16>(), any::<u32>()),
+        (any::<u32>(), any::<[u8; 2]>(), any::<u16>(), any::<u32>()),
     )
         .prop_map(
-            |((pv, session, [ma, mi, pa], device_id), ([c, m, b], mb, cap))| HelloAck {
+            |((pv, session, [ma, mi, pa], device_id), (c, [m, b], mb, cap))| HelloAck {
                 protocol_version: pv,
                 session,
                 firmware: FirmwareVersion {
@@ -262,11 +296,7 @@ pub fn message() -> impl Strategy<Value = Owned> {
             .prop_map(|(t0_ns, end_index)| Message::Start(Start { t0_ns, end_index }))
             .boxed()),
         m(Just(Message::Stop).boxed()),
-        (
-            any::<u64>(),
-            prop::collection::vec(any::<Image>(), 0..=MAX_IMAGES_PER_BATCH)
-        )
-            .prop_map(|(i, v)| Owned::Images(i, v)),
+        (any::<u64>(), images()).prop_map(|(i, v)| Owned::Images(i, v)),
         (
             any::<u64>(),
             prop::collection::vec(truth(), 0..=MAX_KINEMATICS_PER_BATCH)

@@ -388,6 +388,10 @@ impl<'a> ImageItems<'a> {
 
     fn emit(&self, w: &mut Writer<'_>) -> Result<(), Error> {
         let image_len = self.image_len();
+        // Length 0 means "no image": images of no bytes would be read back as none.
+        if image_len == 0 && !self.is_empty() {
+            return Err(Error::InvalidValue);
+        }
         // image_len ≤ MAX_IMAGE_LEN (32) by construction of `Image`.
         w.u8(image_len as u8)?;
         match self.repr {
