@@ -229,9 +229,11 @@ pub fn stream_sweep(
 /// One row of the link table: a batch of `items` items of `item_len` bytes.
 #[derive(Clone, Copy, Debug)]
 pub struct LinkRow {
+    /// What the items are: a chip model's images, or kinematics (`None`).
+    pub chip: Option<margemu_protocol::chip::ChipModel>,
     /// Items per batch frame.
     pub items: usize,
-    /// Bytes per item (22 image, 53 kinematics).
+    /// Bytes per item (the model's image length, 53 for kinematics).
     pub item_len: usize,
     /// Worst-case wire bytes of the frame.
     pub wire_bytes: usize,
@@ -249,21 +251,32 @@ impl LinkRow {
     }
 }
 
-/// Worst-case link efficiency of image batches (1 to 69 images) and kinematics batches (1 to
-/// 28 samples).
+/// Worst-case link efficiency of image batches of every chip model (1 image to a full frame)
+/// and kinematics batches (1 to 28 samples).
 pub fn link_table() -> Vec<LinkRow> {
+    use margemu_protocol::chip::ChipModel;
     use margemu_protocol::link::{
-        IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
+        max_images_per_batch, IMAGE_BATCH_HEADER_LEN, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
     };
-    let images = [1, 8, 16, 32, MAX_IMAGES_PER_BATCH].map(|n| (n, IMAGE_LEN));
-    let kinematics = [1, 8, 16, MAX_KINEMATICS_PER_BATCH].map(|n| (n, TRUTH_LEN));
-    images
-        .into_iter()
-        .chain(kinematics)
-        .map(|(items, item_len)| LinkRow {
+    let mut rows = Vec::new();
+    for chip in ChipModel::ALL {
+        let len = chip.image_len();
+        for items in [1, 8, 16, 32, max_images_per_batch(len)] {
+            rows.push(LinkRow {
+                chip: Some(chip),
+                items,
+                item_len: len,
+                wire_bytes: crate::stream::batch_wire_len(items, len, IMAGE_BATCH_HEADER_LEN),
+            });
+        }
+    }
+    for items in [1, 8, 16, MAX_KINEMATICS_PER_BATCH] {
+        rows.push(LinkRow {
+            chip: None,
             items,
-            item_len,
-            wire_bytes: crate::stream::batch_wire_len(items, item_len),
-        })
-        .collect()
+            item_len: TRUTH_LEN,
+            wire_bytes: crate::stream::batch_wire_len(items, TRUTH_LEN, 8),
+        });
+    }
+    rows
 }

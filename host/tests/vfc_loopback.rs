@@ -212,7 +212,7 @@ fn images_for_other_full_scales_stop_the_device_with_the_reason() {
     let session = Session::new(&scene, stream, &dir).unwrap();
     let (host, device) = TTYPort::pair().unwrap();
     let (rig, _fc_port) =
-        margemu::vfc::spawn(device, config(FilterKind::Ekf), settings.image).unwrap();
+        margemu::vfc::spawn(device, config(FilterKind::Ekf), settings.chip).unwrap();
     let result = session.run_on_port(host, |_| {});
     let out = rig.stop();
     assert!(result.is_err(), "{result:?}");

@@ -161,7 +161,7 @@ fn images(elf: &Path, rate: u32, o: &Options) -> Row {
     drop(qemu);
     let _ = std::fs::remove_dir_all(&dir);
     let check = log.lock().expect("log").0.check(&predicted);
-    let link = rate as f64 * image_batch_wire_len(batch) as f64 / batch as f64;
+    let link = rate as f64 * image_batch_wire_len(batch, 22) as f64 / batch as f64;
     match result {
         Ok(s) => Row {
             mode: "images (a)",

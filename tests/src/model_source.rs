@@ -9,12 +9,11 @@
 //! The kinematics are the scene's truth at every `decimation`-th output sample, so they carry
 //! the same instants as the scene's own truth: `truth_rate = output rate / decimation`.
 
+use margemu::scene::chip::ChipSetup;
 use margemu::scene::Scene;
-use margemu::stream::{predict_model, rate_of, ImageSettings, StreamError, WHO_AM_I};
-use margemu_firmware::chip::Mpu6xxx;
+use margemu::stream::{predict_model, rate_of, ImageSettings, StreamError};
 use margemu_model::sensor::Truth;
 use margemu_protocol::link::{Configure, Image, ModelParams, Rate, Source, CRC32C};
-use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
 
 /// One scene prepared for source mode (b).
 #[derive(Clone, Debug)]
@@ -27,8 +26,8 @@ pub struct ModelStream {
     pub kinematics: Vec<Truth>,
     /// The image the device must serve at each output sample of the scene.
     pub images: Vec<Image>,
-    /// The register settings the images were converted with (the chip's power-on settings).
-    pub image_config: ImageConfig,
+    /// The scene's chip, whose Configure settings the images were converted with.
+    pub chip: ChipSetup,
 }
 
 /// Why a scene cannot be streamed in source mode (b).
@@ -68,7 +67,7 @@ impl ModelStream {
             params: prediction.params,
             kinematics: prediction.kinematics,
             images: prediction.samples.into_iter().map(|s| s.image).collect(),
-            image_config: Mpu6xxx::new().image_config(),
+            chip: scene.chip,
         })
     }
 
@@ -77,7 +76,7 @@ impl ModelStream {
         Configure {
             source: Source::Model(self.params),
             telemetry_period_ns,
-            ..Configure::new(WHO_AM_I, self.out_rate)
+            ..self.chip.configure(self.out_rate)
         }
     }
 

@@ -64,7 +64,7 @@ impl Cmd {
             }
         }
         println!(
-            "\nWorst-case link efficiency of a batch frame (header, first index, items, CRC, \
+            "\nWorst-case link efficiency of a batch frame (header, first index, image length, items, CRC, \
              worst-case COBS, both delimiters) and the items per second a UART carries at 10 line \
              bits per byte (8N1; line bytes/s: {}):\n",
             BAUDS.map(|b| format!("{} at {b} baud", b / 10)).join(", ")
@@ -72,10 +72,9 @@ impl Cmd {
         println!("| batch | items | wire bytes | item bytes / wire byte | 921 600 baud | 2 Mbaud | 3 Mbaud |");
         println!("|---|---|---|---|---|---|---|");
         for l in link_table() {
-            let kind = if l.item_len == margemu_protocol::link::IMAGE_LEN {
-                "images"
-            } else {
-                "kinematics"
+            let kind = match l.chip {
+                Some(chip) => format!("{} images ({} B)", chip.part_name(), l.item_len),
+                None => "kinematics".to_owned(),
             };
             let rates = BAUDS.map(|b| format!("{:.0} /s", l.items_per_s(b)));
             println!(

@@ -53,7 +53,7 @@ impl Cmd {
         let mut session = prepare(&scene, config, &dir)?;
         let (device, dut) = match vfc {
             Some(cfg) => {
-                let expected = margemu::vfc::board::image_config();
+                let expected = margemu::vfc::board::chip_settings();
                 let (rig, port) = margemu::vfc::spawn(device_end, cfg, expected)?;
                 let config = DutConfig::new(DutProtocol::Mavlink);
                 let dut = margemu::vfc::attach(&mut session, port, config, &dir)?;

@@ -155,12 +155,13 @@ impl Cmd {
 fn resend_after(batch: usize, baud: u32) -> Duration {
     use margemu::stream::batch_wire_len;
     use margemu_protocol::link::{
-        IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
-    };
-    let bytes = batch_wire_len(batch.min(MAX_IMAGES_PER_BATCH), IMAGE_LEN).max(batch_wire_len(
-        batch.min(MAX_KINEMATICS_PER_BATCH),
+        max_images_per_batch, IMAGE_BATCH_HEADER_LEN, MAX_IMAGE_LEN, MAX_KINEMATICS_PER_BATCH,
         TRUTH_LEN,
-    ));
+    };
+    let images = batch.min(max_images_per_batch(MAX_IMAGE_LEN));
+    let kinematics = batch.min(MAX_KINEMATICS_PER_BATCH);
+    let bytes = batch_wire_len(images, MAX_IMAGE_LEN, IMAGE_BATCH_HEADER_LEN)
+        .max(batch_wire_len(kinematics, TRUTH_LEN, 8));
     let line = Duration::from_secs_f64(10.0 * bytes as f64 / f64::from(baud.max(1)));
     Duration::from_millis(20) + 2 * line
 }

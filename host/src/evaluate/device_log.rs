@@ -5,18 +5,18 @@
 //! Scene time 0 is `start_host_ns` from `meta.toml` when present, otherwise from the `start`
 //! row of `events.csv` (`detail` = `start_host_ns N; …`, as `margemu stream` writes it).
 //!
-//! Register images are decoded with the `[image]` settings of `meta.toml` (full scales, ASA,
-//! offsets; the power-on defaults when absent) by inverting `margemu_protocol::regmap`'s
-//! conversions: specific force in m/s², the field in the scene's unit (µT ÷ `mag_ut_per_unit`),
-//! both in the MPU-9250's accel/gyro axes (the plate's axes: the chip is mounted with them). What
+//! Register images are decoded by the chip module of `meta.toml`'s `[chip] model` (the MPU-9250
+//! when absent) with the settings of `[chip]` (full scales) and `[image]` (the 6xxx family's ASA
+//! and offsets; the power-on defaults when absent), through
+//! [`ChipSettings::decode`](margemu_protocol::chip::ChipSettings::decode): specific force in
+//! m/s², the field in the scene's unit (µT ÷ `mag_ut_per_unit`), both in the chip's axes. What
 //! the chip clipped stays clipped: the plots show what the device under test was given.
 
 use crate::csv_column::ColumnError;
 use crate::csv_table::Table;
-use margemu_protocol::link::IMAGE_LEN;
+use crate::stream::parse_image_hex;
+use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion, FullScale};
 use margemu_protocol::regmap::ak8963::MagBits;
-use margemu_protocol::regmap::mpu6xxx::convert::{asa_factor, STANDARD_GRAVITY};
-use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
 use margemu_protocol::regmap::mpu6xxx::AccelFs;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -45,7 +45,15 @@ impl From<ColumnError> for SessionFileError {
 struct MetaFile {
     start_host_ns: Option<i64>,
     mag_ut_per_unit: Option<f64>,
+    chip: Option<ChipMeta>,
     image: Option<ImageMeta>,
+}
+
+#[derive(Deserialize)]
+struct ChipMeta {
+    model: String,
+    accel_range_g: f64,
+    gyro_range_dps: f64,
 }
 
 #[derive(Deserialize)]
@@ -61,8 +69,8 @@ struct ImageMeta {
 pub struct SessionMeta {
     /// Host time (ns) of scene time 0.
     pub start_host_ns: i64,
-    /// Register settings of the images sent.
-    pub image: ImageConfig,
+    /// The chip and the register settings of the images sent.
+    pub chip: ChipSettings,
     /// µT per unit of the scene's field.
     pub mag_ut_per_unit: f64,
 }
@@ -83,8 +91,20 @@ pub fn read_meta(dir: &Path) -> Result<SessionMeta, SessionFileError> {
         Some(ns) => ns,
         None => start_from_events(&dir.join("events.csv"))?,
     };
-    let mut image = ImageConfig::NOMINAL;
-    if let Some(m) = meta.image {
+    let mut chip = match &meta.chip {
+        None => ChipSettings::power_on(ChipModel::Mpu9250),
+        Some(c) => {
+            let model = ChipModel::from_name(&c.model)
+                .ok_or_else(|| bad(&path, format!("[chip] model = {:?} is no chip", c.model)))?;
+            let fs = FullScale {
+                accel_g: c.accel_range_g,
+                gyro_dps: c.gyro_range_dps,
+            };
+            ChipSettings::with_full_scale(model, fs)
+                .map_err(|e| bad(&path, format!("[chip]: {e:?}")))?
+        }
+    };
+    if let (Some(m), Conversion::Mpu6xxx(image)) = (meta.image, &mut chip.conversion) {
         image.accel_fs = pick(&path, "accel_fs", &m.accel_fs, &AccelFs::ALL)?;
         image.mag_bits = pick(
             &path,
@@ -97,7 +117,7 @@ pub fn read_meta(dir: &Path) -> Result<SessionMeta, SessionFileError> {
     }
     Ok(SessionMeta {
         start_host_ns,
-        image,
+        chip,
         mag_ut_per_unit: meta.mag_ut_per_unit.unwrap_or(1.0),
     })
 }
@@ -147,23 +167,14 @@ fn start_from_events(path: &Path) -> Result<i64, SessionFileError> {
     })
 }
 
-/// Specific force (m/s²) and field (scene unit) of one register image.
-pub fn decode(image: &[u8; IMAGE_LEN], meta: &SessionMeta) -> ([f64; 3], [f64; 3]) {
-    let r = ImageRepr::parse(image);
-    let cfg = &meta.image;
-    let lsb_per_g = f64::from(cfg.accel_fs.lsb_per_g());
-    let acc = core::array::from_fn(|i| {
-        let offset = f64::from(cfg.accel_offset[i] & !1) * lsb_per_g / 2048.0;
-        (f64::from(r.accel[i]) - offset) / lsb_per_g * f64::from(STANDARD_GRAVITY)
-    });
-    let ut = |i: usize| {
-        f64::from(r.mag[i])
-            * f64::from(cfg.mag_bits.ut_per_lsb())
-            * f64::from(asa_factor(cfg.asa[i]))
-    };
-    // AK8963 axes back to the MPU-9250's: x = y_ak, y = x_ak, z = −z_ak.
-    let mag = [ut(1), ut(0), -ut(2)].map(|b| b / meta.mag_ut_per_unit);
-    (acc, mag)
+/// Specific force (m/s²) and field (scene unit; NaN for a chip without magnetometer) of one
+/// register image; `None` if it is not of the chip's length.
+pub fn decode(image: &[u8], meta: &SessionMeta) -> Option<([f64; 3], [f64; 3])> {
+    let r = meta.chip.decode(image)?;
+    let mag = r
+        .mag_ut
+        .map_or([f64::NAN; 3], |m| m.map(|b| b / meta.mag_ut_per_unit));
+    Some((r.acc, mag))
 }
 
 /// `sent.csv` decoded: `(t_ns, specific force, field)` per row.
@@ -175,21 +186,15 @@ pub fn read_sent(path: &Path, meta: &SessionMeta) -> Result<super::input::Imu, C
         let t_ns: u64 = row.int(t)?;
         row.check_order(t, imu.t_ns.last().copied(), t_ns, true)?;
         let text = row.text(image);
-        let mut bytes = [0u8; IMAGE_LEN];
-        let ok = text.len() == 2 * IMAGE_LEN
-            && bytes.iter_mut().enumerate().all(|(i, b)| {
-                text.get(2 * i..2 * i + 2)
-                    .and_then(|h| u8::from_str_radix(h, 16).ok())
-                    .map(|v| *b = v)
-                    .is_some()
-            });
-        if !ok {
+        let len = meta.chip.model.image_len();
+        let decoded = parse_image_hex(text, len).and_then(|bytes| decode(&bytes, meta));
+        let Some((acc, mag)) = decoded else {
             return Err(row.error(format!(
-                "`image` = {text:?} is not {} hex digits",
-                2 * IMAGE_LEN
+                "`image` = {text:?} is not {} hex digits (a {} image)",
+                2 * len,
+                meta.chip.model.part_name()
             )));
-        }
-        let (acc, mag) = decode(&bytes, meta);
+        };
         imu.t_ns.push(t_ns);
         imu.acc.push(acc);
         imu.mag.push(mag);
@@ -201,28 +206,33 @@ pub fn read_sent(path: &Path, meta: &SessionMeta) -> Result<super::input::Imu, C
 #[cfg(test)]
 mod tests {
     use super::*;
+    use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
     use margemu_protocol::regmap::mpu6xxx::GyroFs;
 
     #[test]
     fn decode_inverts_the_image_conversion_to_within_one_lsb() {
+        let image = ImageConfig {
+            accel_fs: AccelFs::G8,
+            gyro_fs: GyroFs::Dps2000,
+            mag_bits: MagBits::Bits16,
+            asa: [120, 128, 140],
+            gyro_offset: [0; 3],
+            accel_offset: [100, -64, 0],
+        };
         let meta = SessionMeta {
             start_host_ns: 0,
-            image: ImageConfig {
-                accel_fs: AccelFs::G8,
-                gyro_fs: GyroFs::Dps2000,
-                mag_bits: MagBits::Bits16,
-                asa: [120, 128, 140],
-                gyro_offset: [0; 3],
-                accel_offset: [100, -64, 0],
+            chip: ChipSettings {
+                model: ChipModel::Mpu9250,
+                conversion: Conversion::Mpu6xxx(image),
             },
             mag_ut_per_unit: 50.0,
         };
         let acc = [1.5f32, -30.0, 9.0];
         let field_nu = [0.5f32, -0.1, -0.83];
         let image =
-            ImageRepr::from_physical(acc, [0.0; 3], 25.0, field_nu.map(|b| b * 50.0), &meta.image)
+            ImageRepr::from_physical(acc, [0.0; 3], 25.0, field_nu.map(|b| b * 50.0), &image)
                 .emit();
-        let (a, m) = decode(&image, &meta);
+        let (a, m) = decode(&image, &meta).unwrap();
         for i in 0..3 {
             assert!((a[i] - f64::from(acc[i])).abs() < 9.81 / 4096.0, "{a:?}");
             assert!(

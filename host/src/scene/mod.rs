@@ -18,6 +18,7 @@
 //! assert_eq!(scene.samples(), 200);
 //! ```
 
+pub mod chip;
 mod error;
 mod schema;
 pub mod sensors;
@@ -44,6 +45,8 @@ pub struct Scene {
     pub duration_ns: Nanos,
     /// Integrator sub-step in nanoseconds.
     pub step_ns: Nanos,
+    /// The emulated chip (`[chip]`, or the default MPU-9250).
+    pub chip: chip::ChipSetup,
 }
 
 impl Scene {
@@ -66,6 +69,7 @@ impl Scene {
             clock: checked.clock,
             duration_ns: checked.duration_ns,
             step_ns: checked.step_ns,
+            chip: checked.chip,
         })
     }
 

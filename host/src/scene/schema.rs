@@ -51,6 +51,9 @@ pub struct SceneSpec {
     /// Magnetic perturbation bursts; none when the table is absent.
     #[serde(default)]
     pub perturbation: Option<PerturbationSpec>,
+    /// The emulated chip; the MPU-9250 at power-on when the table is absent.
+    #[serde(default)]
+    pub chip: Option<super::chip::ChipSpec>,
 }
 
 /// How the plate's motion is produced; a scene pays only for the mode it names.

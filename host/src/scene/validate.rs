@@ -10,6 +10,7 @@ pub(crate) struct Checked {
     pub clock: SampleClock,
     pub duration_ns: Nanos,
     pub step_ns: Nanos,
+    pub chip: super::chip::ChipSetup,
 }
 
 type Check = Result<(), Violation>;
@@ -42,10 +43,12 @@ pub(crate) fn check(spec: &SceneSpec) -> Result<Checked, Violation> {
         check_joint(name, source, spec.motion)?;
     }
     check_sensors(spec)?;
+    let chip = super::chip::resolve(spec.chip.as_ref(), spec.rate)?;
     Ok(Checked {
         clock,
         duration_ns,
         step_ns,
+        chip,
     })
 }
 

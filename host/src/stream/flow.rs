@@ -9,7 +9,7 @@ use super::served::ServedCheck;
 use super::session::Session;
 use super::{JitterStats, LinkStats, Progress, StreamError, Summary};
 use margemu_protocol::link::{
-    Chips, Credit, Encoder, Hello, HelloAck, Message, RxStats, Telemetry, CRC32C,
+    Credit, Encoder, Hello, HelloAck, Message, RxStats, Telemetry, CRC32C,
 };
 use margemu_protocol::PROTOCOL_VERSION;
 use std::io::Write;
@@ -223,12 +223,13 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         }
         let caps = ack.capabilities;
         let (mode, no_mode) = self.session.required_mode();
-        let missing = if !caps.chips.contains(Chips::MPU9250) {
-            Some("it does not emulate the MPU-9250")
+        let model = self.session.chip.model;
+        let missing = if !caps.chips.has(model) {
+            Some(format!("it does not emulate the {}", model.part_name()))
         } else if !caps.modes.contains(mode) {
-            Some(no_mode)
+            Some(no_mode.to_owned())
         } else if caps.max_batch == 0 || caps.buffer_capacity == 0 {
-            Some("it announces no batch or buffer space")
+            Some("it announces no batch or buffer space".to_owned())
         } else {
             None
         };

@@ -1,10 +1,10 @@
 //! The host's prediction: every register image of a scene, computed before streaming.
 //!
-//! Per output sample `k`: truth → [`MargSim`] (the shared `model` crate, as `simulate` runs it)
-//! → physical units of the chip (field × [`ImageSettings::mag_ut_per_unit`] µT, die temperature
-//! from `[sensors] temperature` or [`ImageSettings::default_temp_c`]) →
-//! [`ImageRepr::from_physical`] with the explicit [`ImageSettings::image`] register settings.
-//! The chip is mounted with the plate's axes (identity rotation).
+//! Per output sample `k`: truth, turned into the chip's axes by the scene's `[chip] rotation` →
+//! [`MargSim`] (the shared `model` crate, as `simulate` runs it) → physical units of the chip
+//! (field × [`ImageSettings::mag_ut_per_unit`] µT, die temperature from `[sensors] temperature`
+//! or [`ImageSettings::default_temp_c`]) → the chip module's conversion with the explicit
+//! [`ImageSettings::chip`] register settings ([`ChipSettings::image`]).
 //!
 //! ```
 //! use margemu::scene::Scene;
@@ -20,10 +20,11 @@
 //! ```
 
 use crate::marg::MargSim;
+use crate::scene::chip::ChipSetup;
 use crate::scene::{FieldUnit, Scene};
 use crate::truth::Truth;
+use margemu_protocol::chip::{ChipSettings, PhysicalSample};
 use margemu_protocol::link::Image;
-use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
 
 /// µT per normalized field unit ("nu") unless told otherwise: the author's reference field has
 /// about unit norm, and 50 µT is a typical geomagnetic magnitude.
@@ -32,9 +33,10 @@ pub const DEFAULT_UT_PER_NU: f64 = 50.0;
 /// How physical samples become register images. Every field is written to `meta.toml`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageSettings {
-    /// Full scales, magnetometer resolution, fuse ROM ASA and offsets assumed for the chip.
-    /// The emulated chip's power-on state ([`chip_power_on`]) unless the caller says otherwise.
-    pub image: ImageConfig,
+    /// The chip model and the register settings (full scales, magnetometer resolution, fuse
+    /// ROM, offsets) its images are computed with: the scene's `[chip]` unless the caller says
+    /// otherwise.
+    pub chip: ChipSettings,
     /// µT per unit of the scene's magnetic field.
     pub mag_ut_per_unit: f64,
     /// Die temperature when the scene names none, °C.
@@ -42,11 +44,11 @@ pub struct ImageSettings {
 }
 
 impl ImageSettings {
-    /// The emulated chip's power-on settings ([`chip_power_on`]); 1 µT per unit for µT scenes, [`DEFAULT_UT_PER_NU`] for
-    /// normalized ones; 25 °C.
+    /// The scene's chip settings (`[chip]`: power-on with its full scales); 1 µT per unit for µT
+    /// scenes, [`DEFAULT_UT_PER_NU`] for normalized ones; 25 °C.
     pub fn for_scene(scene: &Scene) -> Self {
         Self {
-            image: chip_power_on(),
+            chip: scene.chip.settings,
             mag_ut_per_unit: match scene.spec.field.unit {
                 FieldUnit::Microtesla => 1.0,
                 FieldUnit::Normalized => DEFAULT_UT_PER_NU,
@@ -56,19 +58,12 @@ impl ImageSettings {
     }
 }
 
-/// The conversion of the emulated chip at power-on, as the firmware's chip reports it: ±2 g,
-/// ±250 °/s, AK8963 14-bit, the AK8963's fuse ROM sensitivity adjustment (ASA, so a driver that
-/// applies it reads the true field), no offsets.
-pub fn chip_power_on() -> ImageConfig {
-    margemu_firmware::chip::Mpu6xxx::new().image_config()
-}
-
 /// One output sample: its truth and the register image the device should serve for it.
 #[derive(Clone, Copy, Debug)]
 pub struct PredictedSample {
     /// Ground truth at the latch instant (`truth.t_ns`).
     pub truth: Truth,
-    /// The 22-byte register image.
+    /// The register image, of the chip model's length.
     pub image: Image,
 }
 
@@ -81,37 +76,57 @@ pub fn predict(
     let temperature = scene.spec.sensors.temperature;
     let mut out = Vec::with_capacity(scene.samples() as usize);
     crate::run::for_each(scene, |truth| {
-        let s = marg.sample(truth).sample;
+        let s = marg.sample(&in_chip_axes(truth, &scene.chip)).sample;
         // Same expression as `MargSim`, so the temperature the model sees is the one sent.
         let temp_c = temperature.map_or(settings.default_temp_c, |[start, slope]| {
             (start + slope * truth.t_ns as f64 * 1e-9) as f32
         });
-        let mag_ut = s
-            .mag
-            .map(|v| (f64::from(v) * settings.mag_ut_per_unit) as f32);
-        let repr = ImageRepr::from_physical(s.acc, s.gyr, temp_c, mag_ut, &settings.image);
+        let sample = PhysicalSample {
+            acc: s.acc,
+            gyr: s.gyr,
+            mag: s
+                .mag
+                .map(|v| (f64::from(v) * settings.mag_ut_per_unit) as f32),
+            temp_c,
+        };
         out.push(PredictedSample {
             truth: *truth,
-            image: repr.emit(),
+            image: settings.chip.image(&sample),
         });
     })?;
     Ok(out)
 }
 
-/// Lowercase hex of an image (44 characters), as in `sent.csv`.
-pub fn image_hex(image: &Image) -> String {
+/// The truth's body-frame vectors (rate, specific force, field, angular acceleration) in the
+/// chip's axes (`[chip] rotation`); the rest as it is.
+pub fn in_chip_axes(truth: &Truth, chip: &ChipSetup) -> Truth {
+    if chip.rotation.is_none() {
+        return *truth;
+    }
+    Truth {
+        body_rate: chip.to_chip(truth.body_rate),
+        specific_force: chip.to_chip(truth.specific_force),
+        field_body: chip.to_chip(truth.field_body),
+        angular_accel: chip.to_chip(truth.angular_accel),
+        accel_body: chip.to_chip(truth.accel_body),
+        ..*truth
+    }
+}
+
+/// Lowercase hex of an image (two digits per byte), as in `sent.csv`.
+pub fn image_hex(image: &[u8]) -> String {
     image.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Parses [`image_hex`] back; `None` unless exactly 44 hex digits.
-pub fn parse_image_hex(hex: &str) -> Option<Image> {
+/// Parses [`image_hex`] back; `None` unless it is `2 · len` hex digits.
+pub fn parse_image_hex(hex: &str, len: usize) -> Option<Image> {
     let bytes = hex.as_bytes();
-    if bytes.len() != 2 * margemu_protocol::link::IMAGE_LEN {
+    if bytes.len() != 2 * len {
         return None;
     }
-    let mut out = [0u8; margemu_protocol::link::IMAGE_LEN];
-    for (i, pair) in bytes.chunks(2).enumerate() {
-        out[i] = u8::from_str_radix(std::str::from_utf8(pair).ok()?, 16).ok()?;
+    let mut out = Image::zeroed(len)?;
+    for (slot, pair) in out.as_mut_bytes().iter_mut().zip(bytes.chunks(2)) {
+        *slot = u8::from_str_radix(std::str::from_utf8(pair).ok()?, 16).ok()?;
     }
     Some(out)
 }
@@ -122,12 +137,14 @@ mod tests {
 
     #[test]
     fn hex_round_trips() {
-        let mut image = [0u8; 22];
-        image[0] = 0xAB;
-        image[21] = 0x01;
+        let mut bytes = [0u8; 22];
+        bytes[0] = 0xAB;
+        bytes[21] = 0x01;
+        let image = Image::from(bytes);
         let hex = image_hex(&image);
         assert_eq!(&hex[..4], "ab00");
-        assert_eq!(parse_image_hex(&hex), Some(image));
-        assert_eq!(parse_image_hex("zz"), None);
+        assert_eq!(parse_image_hex(&hex, 22), Some(image));
+        assert_eq!(parse_image_hex(&hex, 14), None);
+        assert_eq!(parse_image_hex("zz", 1), None);
     }
 }

@@ -1,9 +1,12 @@
-//! `meta.toml` of a session: what produced it (versions, scene, seed, port, rates, the register
-//! settings of the images) and, appended after the handshake, the device's `[device]` table.
+//! `meta.toml` of a session: what produced it (versions, scene, seed, port, rates, the chip and
+//! the register settings of the images) and, appended after the handshake, the device's
+//! `[device]` table.
 
 use super::images::ImageSettings;
-use super::session::{StreamConfig, WHO_AM_I};
+use super::session::StreamConfig;
+use crate::scene::chip::{ChipSetup, Rotation};
 use crate::scene::Scene;
+use margemu_protocol::chip::Conversion;
 use margemu_protocol::link::{HelloAck, Rate};
 use margemu_protocol::PROTOCOL_VERSION;
 use serde::Serialize;
@@ -22,7 +25,6 @@ struct Meta<'a> {
     rate_den: u32,
     port: &'a str,
     baud: u32,
-    who_am_i: u8,
     source: &'a str,
     kinematics_hold: Option<u32>,
     kinematics_rate_hz: Option<f64>,
@@ -33,10 +35,25 @@ struct Meta<'a> {
     field_unit: &'a str,
     mag_ut_per_unit: f64,
     default_temp_c: f32,
-    image: ImageMeta,
+    chip: ChipMeta,
+    image: Option<ImageMeta>,
     scene_text: &'a str,
 }
 
+/// `[chip]`: the emulated chip and the full scales of the images.
+#[derive(Serialize)]
+struct ChipMeta {
+    model: &'static str,
+    who_am_i: u8,
+    bus: &'static str,
+    i2c_address: u8,
+    image_len: usize,
+    accel_range_g: f64,
+    gyro_range_dps: f64,
+    rotation: Option<Rotation>,
+}
+
+/// `[image]`: the InvenSense 6xxx family's further conversion settings (offsets, AK8963).
 #[derive(Serialize)]
 struct ImageMeta {
     accel_fs: String,
@@ -55,7 +72,6 @@ pub(super) fn metadata(
     rate: Rate,
     hold: Option<u32>,
 ) -> String {
-    let i = &s.image;
     let meta = Meta {
         margemu_version: env!("CARGO_PKG_VERSION"),
         protocol_version: PROTOCOL_VERSION,
@@ -69,7 +85,6 @@ pub(super) fn metadata(
         rate_den: rate.den(),
         port: &c.port,
         baud: c.baud,
-        who_am_i: WHO_AM_I,
         source: if hold.is_some() { "model" } else { "images" },
         kinematics_hold: hold,
         kinematics_rate_hz: hold.map(|h| rate.as_hz_f64() / f64::from(h)),
@@ -80,17 +95,34 @@ pub(super) fn metadata(
         field_unit: scene.spec.field.unit.symbol(),
         mag_ut_per_unit: s.mag_ut_per_unit,
         default_temp_c: s.default_temp_c,
-        image: ImageMeta {
-            accel_fs: format!("{:?}", i.accel_fs),
-            gyro_fs: format!("{:?}", i.gyro_fs),
-            mag_bits: format!("{:?}", i.mag_bits),
-            asa: i.asa,
-            gyro_offset: i.gyro_offset,
-            accel_offset: i.accel_offset,
+        chip: chip_meta(&scene.chip, s),
+        image: match &s.chip.conversion {
+            Conversion::Mpu6xxx(i) => Some(ImageMeta {
+                accel_fs: format!("{:?}", i.accel_fs),
+                gyro_fs: format!("{:?}", i.gyro_fs),
+                mag_bits: format!("{:?}", i.mag_bits),
+                asa: i.asa,
+                gyro_offset: i.gyro_offset,
+                accel_offset: i.accel_offset,
+            }),
         },
         scene_text: &scene.text,
     };
     toml::to_string(&meta).expect("metadata serializes")
+}
+
+fn chip_meta(chip: &ChipSetup, s: &ImageSettings) -> ChipMeta {
+    let fs = s.chip.full_scale();
+    ChipMeta {
+        model: s.chip.model.name(),
+        who_am_i: chip.who_am_i,
+        bus: chip.bus.name(),
+        i2c_address: chip.i2c_address,
+        image_len: s.chip.model.image_len(),
+        accel_range_g: fs.accel_g,
+        gyro_range_dps: fs.gyro_dps,
+        rotation: chip.rotation,
+    }
 }
 
 /// The `[device]` table appended to `meta.toml` after HelloAck.

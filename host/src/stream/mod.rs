@@ -4,15 +4,16 @@
 //!
 //! A [`Session`] first predicts every register image the device will serve for a validated
 //! [`Scene`](crate::scene::Scene): in mode (a) [`predict`] (truth →
-//! [`MargSim`](crate::marg::MargSim) → [`ImageRepr::from_physical`] with an explicit
+//! [`MargSim`](crate::marg::MargSim) → the chip module's conversion with an explicit
 //! [`ImageSettings`]), in mode (b) [`predict_model`] (the firmware's zero-order hold of the
 //! kinematics and model steps, see [`model`]; scenes the device cannot run are refused here,
 //! before anything is sent). Then it speaks the link protocol over any byte port:
 //!
 //! 1. Hello → HelloAck: the protocol version must match, and the device must emulate the
-//!    MPU-9250 and support the source mode;
-//! 2. Configure (WHO_AM_I 0x71, the scene's exact rate, the source and, in mode (b), the model
-//!    parameters) → the first Credit;
+//!    scene's chip model and support the source mode;
+//! 2. Configure (the scene's `[chip]`: model, identity, image length, I2C address and full-scale
+//!    overrides; the scene's exact rate, the source and, in mode (b), the model parameters) →
+//!    the first Credit;
 //! 3. prefill (the items due within the lead, as far as the window allows), then Start
 //!    (`t0_ns` = 0, `end_index` = the scene's sample count), which sets scene time 0 on the
 //!    host's monotonic clock; the device stops by itself at the scene's end;
@@ -49,9 +50,9 @@ mod session;
 mod source;
 
 pub use images::{image_hex, parse_image_hex, predict, ImageSettings, PredictedSample};
-pub use model::{kinematics_hold, model_images, predict_model, ModelPrediction};
+pub use model::{device_chip, kinematics_hold, model_images, predict_model, ModelPrediction};
 pub use served::{ServedCheck, ServedStats};
-pub use session::{rate_of, Session, SourceMode, StreamConfig, WHO_AM_I};
+pub use session::{rate_of, Session, SourceMode, StreamConfig};
 
 use margemu_protocol::link::{HelloAck, RxStats, Telemetry};
 use std::path::PathBuf;
@@ -96,7 +97,7 @@ pub enum StreamError {
     /// the device cannot serve this session: {reason}
     Unsupported {
         /// What is missing.
-        reason: &'static str,
+        reason: String,
     },
     /// no credit for sample {index} within {timeout:?}: the device stopped granting its window
     CreditTimeout {
@@ -265,12 +266,12 @@ pub struct Summary {
     pub elapsed: Duration,
 }
 
-/// Worst-case wire bytes of a batch frame of `n` items of `item_len` bytes each (22 for an
-/// image, 53 for a kinematics sample): header, first index, items, CRC, worst-case COBS and
-/// both delimiters.
-pub fn batch_wire_len(n: usize, item_len: usize) -> usize {
+/// Worst-case wire bytes of a batch frame of `n` items of `item_len` bytes each behind a batch
+/// header of `header_len` bytes (an image batch's 9, a kinematics batch's 8): frame header,
+/// batch header, items, CRC, worst-case COBS and both delimiters.
+pub fn batch_wire_len(n: usize, item_len: usize, header_len: usize) -> usize {
     use margemu_protocol::link::{max_wire_len, CRC_LEN, HEADER_LEN};
-    max_wire_len(HEADER_LEN + 8 + n * item_len + CRC_LEN)
+    max_wire_len(HEADER_LEN + header_len + n * item_len + CRC_LEN)
 }
 
 /// Opens a serial port for a session (no exclusive lock, 50 ms read timeout).
@@ -288,10 +289,13 @@ mod tests {
 
     #[test]
     fn batch_sizes_agree_with_the_protocol() {
-        use margemu_protocol::link::{image_batch_wire_len, IMAGE_LEN, TRUTH_LEN};
-        assert_eq!(batch_wire_len(32, IMAGE_LEN), image_batch_wire_len(32));
-        assert_eq!(batch_wire_len(32, IMAGE_LEN), 727);
-        assert_eq!(batch_wire_len(28, TRUTH_LEN), 1510); // docs/spec/link.md §9
+        use margemu_protocol::link::{image_batch_wire_len, IMAGE_BATCH_HEADER_LEN, TRUTH_LEN};
+        for len in [14, 22, 32] {
+            let host = batch_wire_len(32, len, IMAGE_BATCH_HEADER_LEN);
+            assert_eq!(host, image_batch_wire_len(32, len));
+        }
+        assert_eq!(batch_wire_len(32, 22, IMAGE_BATCH_HEADER_LEN), 728);
+        assert_eq!(batch_wire_len(28, TRUTH_LEN, 8), 1510); // docs/spec/link.md §9
     }
 
     #[test]

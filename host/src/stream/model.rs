@@ -14,17 +14,18 @@
 //!   sample `k` from the latest kinematics at or before `t_k`, i.e. `j = k / hold` (zero-order
 //!   hold), steps its model ([`Marg`] with the scene's terms and seed at `rate.as_hz_f64()`)
 //!   once per output instant, scales the field to µT as `(f64::from(mag) * mag_ut_per_unit) as
-//!   f32`, takes the die temperature of the kinematics (21 °C, TEMP_OUT 0, without one) and
-//!   converts with the chip's power-on register settings ([`chip_power_on`]).
+//!   f32`, takes the die temperature of the kinematics (21 °C without one) and converts with
+//!   the settings of the chip the scene's Configure builds (the firmware's own
+//!   `setup::build_chip` and `setup::model_image`, so host and device share every step).
 //!
 //! [`model_images`] is that last step alone, for a caller with its own kinematics (a QEMU test,
 //! say). The prediction holds while the device under test leaves the full-scale and offset
-//! registers at their power-on values (the device converts with the chip's current settings).
+//! registers where Configure put them (the device converts with the chip's current settings).
 //!
 //! Scenes the device cannot run are refused before anything is sent ([`StreamError::Model`]):
-//! a magnetic perturbation (its generator's FFT buffers do not fit a no-alloc device), register
-//! settings other than the chip's power-on ones, and a kinematics rate that does not divide the
-//! output rate.
+//! a magnetic perturbation (its generator's FFT buffers do not fit a no-alloc device), image
+//! settings other than those of the configured chip, and a kinematics rate that does not divide
+//! the output rate.
 //!
 //! ```
 //! use margemu::scene::Scene;
@@ -38,15 +39,16 @@
 //! assert_eq!(p.params.truth_rate.as_hz_f64(), 250.0);
 //! ```
 
-use super::images::{chip_power_on, ImageSettings, PredictedSample};
+use super::images::{in_chip_axes, ImageSettings, PredictedSample};
 use super::session::rate_of;
 use super::StreamError;
+use crate::scene::chip::ChipSetup;
 use crate::scene::Scene;
 use crate::truth::Truth;
+use margemu_firmware::chip::{Chip, EmulatedChip};
+use margemu_firmware::link::setup;
 use margemu_model::sensor::{self, Marg};
 use margemu_protocol::link::{Image, ModelParams, Rate};
-use margemu_protocol::regmap::mpu6xxx::convert::TEMP_OFFSET_C;
-use margemu_protocol::regmap::mpu6xxx::image::ImageRepr;
 
 /// The kinematics rate when none is asked for: the output rate over the smallest whole
 /// `hold ≥ 2` that brings it to at most this.
@@ -80,14 +82,15 @@ pub fn predict_model(
                 .into(),
         });
     }
-    if settings.image != chip_power_on() {
+    let rate = rate_of(scene)?;
+    let chip = device_chip(&scene.chip, rate)?;
+    if settings.chip != chip.settings() {
         return Err(StreamError::Model {
-            reason: "the device converts with the chip's power-on register settings; the \
-                     images asked for others"
+            reason: "the device converts with the settings Configure gives its chip (the \
+                     scene's [chip]); the images asked for others"
                 .into(),
         });
     }
-    let rate = rate_of(scene)?;
     let hold = kinematics_hold(rate, kinematics_hz)?;
     let truth_rate = Rate::new(rate.num(), rate.den() * hold).expect("checked by the hold");
     let truths = crate::run::collect(scene).map_err(crate::run::RunError::from)?;
@@ -95,13 +98,13 @@ pub fn predict_model(
     let kinematics: Vec<sensor::Truth> = truths
         .iter()
         .step_by(hold as usize)
-        .map(|t| kinematics_of(t, temperature))
+        .map(|t| kinematics_of(&in_chip_axes(t, &scene.chip), temperature))
         .collect();
     let params = ModelParams {
         mag_ut_per_unit: settings.mag_ut_per_unit,
         ..ModelParams::new(scene.spec.seed, truth_rate, scene.spec.sensors.config())
     };
-    let images = model_images(&params, rate, hold, &kinematics, truths.len())?;
+    let images = model_images(&params, rate, hold, &kinematics, truths.len(), &chip)?;
     let samples = truths
         .into_iter()
         .zip(images)
@@ -115,28 +118,31 @@ pub fn predict_model(
     })
 }
 
+/// The chip a device builds from the Configure of `chip` at `rate`: what it converts with.
+pub fn device_chip(chip: &ChipSetup, rate: Rate) -> Result<EmulatedChip, StreamError> {
+    setup::build_chip(&chip.configure(rate)).map_err(|code| StreamError::Model {
+        reason: format!(
+            "the firmware refuses the {} as configured ({code:?})",
+            chip.model.part_name()
+        ),
+    })
+}
+
 /// The images the device serves at output samples `0 .. samples` in source mode (b), from
-/// `kinematics` held for `hold` output samples each (see the module docs).
+/// `kinematics` held for `hold` output samples each, converted by `chip` (see the module docs).
 pub fn model_images(
     params: &ModelParams,
     rate: Rate,
     hold: u32,
     kinematics: &[sensor::Truth],
     samples: usize,
+    chip: &impl Chip,
 ) -> Result<Vec<Image>, StreamError> {
     let mut marg = Marg::new(&params.marg, rate.as_hz_f64(), params.seed)
         .map_err(crate::run::RunError::Model)?;
-    let config = chip_power_on();
     let held = (0..samples).filter_map(|k| kinematics.get(k / hold.max(1) as usize));
     Ok(held
-        .map(|t| {
-            let s = marg.sample(t);
-            let mag = s
-                .mag
-                .map(|m| (f64::from(m) * params.mag_ut_per_unit) as f32);
-            let temp = t.temperature_c.unwrap_or(TEMP_OFFSET_C);
-            ImageRepr::from_physical(s.acc, s.gyr, temp, mag, &config).emit()
-        })
+        .map(|t| setup::model_image(&mut marg, t, params.mag_ut_per_unit, chip))
         .collect())
 }
 
@@ -200,11 +206,28 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_power_on_conversion_is_nominal_but_for_the_fuse_rom() {
-        use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
-        let c = chip_power_on();
-        assert_eq!(ImageConfig { asa: [128; 3], ..c }, ImageConfig::NOMINAL);
-        assert_ne!(c.asa, [128; 3], "the emulated AK8963 has real fuse values");
+    fn the_device_chip_converts_as_the_scene_says() {
+        use margemu_protocol::chip::{ChipModel, ChipSettings, FullScale};
+        for model in ChipModel::ALL {
+            let Ok(chip) = device_chip(&ChipSetup::power_on(model), Rate::hz(1000).unwrap()) else {
+                continue; // not emulated by this firmware
+            };
+            assert_eq!(chip.settings(), ChipSettings::power_on(model), "{model:?}");
+            let fs = FullScale {
+                accel_g: 16.0,
+                gyro_dps: 2000.0,
+            };
+            let setup = ChipSetup {
+                settings: ChipSettings::with_full_scale(model, fs).unwrap(),
+                ..ChipSetup::power_on(model)
+            };
+            let chip = device_chip(&setup, Rate::hz(1000).unwrap()).unwrap();
+            assert_eq!(
+                chip.settings(),
+                setup.settings,
+                "{model:?} at ±16 g, ±2000 °/s"
+            );
+        }
     }
 
     #[test]

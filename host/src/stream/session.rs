@@ -10,6 +10,7 @@ use super::model::predict_model;
 use super::rx;
 use super::source::Items;
 use super::{Progress, StreamError, Summary};
+use crate::scene::chip::ChipSetup;
 use crate::scene::Scene;
 use margemu_protocol::link::Rate;
 use std::io::{Read, Write};
@@ -17,9 +18,6 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// WHO_AM_I of the emulated chip: the MPU-9250.
-pub const WHO_AM_I: u8 = 0x71;
 
 /// Where the device's samples come from (`docs/spec/link.md` §5.3).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -95,6 +93,8 @@ impl Default for StreamConfig {
 pub struct Session {
     pub(super) config: StreamConfig,
     pub(super) settings: ImageSettings,
+    /// The chip Configure asks for (the scene's `[chip]`).
+    pub(super) chip: ChipSetup,
     pub(super) rate: Rate,
     pub(super) samples: Vec<PredictedSample>,
     pub(super) items: Items,
@@ -140,6 +140,7 @@ impl Session {
         Ok(Self {
             config,
             settings,
+            chip: scene.chip,
             rate,
             samples,
             items,

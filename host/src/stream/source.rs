@@ -1,7 +1,7 @@
 //! What a session writes to the port: the items of its source mode, batch by batch.
 //!
 //! - source (a), register images: one item per output sample, the predicted image, in
-//!   [`ImageBatch`]es (up to 69 per frame);
+//!   [`ImageBatch`]es (up to 68 MPU-9250 or 47 ICM-42688-P images per frame);
 //! - source (b), the device runs the model: one item per kinematics sample, at the kinematics
 //!   rate, in [`KinematicsBatch`]es (up to 28 per frame).
 //!
@@ -11,8 +11,8 @@
 use super::session::{Session, SourceMode};
 use margemu_model::sensor;
 use margemu_protocol::link::{
-    Configure, Encoder, Image, ImageBatch, KinematicsBatch, Message, ModelParams, Modes, Rate,
-    Source, IMAGE_LEN, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
+    max_images_per_batch, Configure, Encoder, Image, ImageBatch, KinematicsBatch, Message,
+    ModelParams, Modes, Rate, Source, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
 };
 use std::io;
 
@@ -66,7 +66,7 @@ impl Session {
     /// Bytes of one item on the wire (before framing).
     pub(super) fn item_len(&self) -> u64 {
         match &self.items {
-            Items::Images => IMAGE_LEN as u64,
+            Items::Images => self.chip.model.image_len() as u64,
             Items::Kinematics { .. } => TRUTH_LEN as u64,
         }
     }
@@ -74,7 +74,7 @@ impl Session {
     /// Most items in one frame.
     pub(super) fn max_per_frame(&self) -> usize {
         match &self.items {
-            Items::Images => MAX_IMAGES_PER_BATCH,
+            Items::Images => max_images_per_batch(self.chip.model.image_len()),
             Items::Kinematics { .. } => MAX_KINEMATICS_PER_BATCH,
         }
     }
@@ -99,7 +99,7 @@ impl Session {
         Configure {
             telemetry_period_ns,
             source,
-            ..Configure::new(super::WHO_AM_I, self.rate)
+            ..self.chip.configure(self.rate)
         }
     }
 

@@ -48,9 +48,17 @@ pub fn image_config() -> ImageConfig {
         accel_fs: ACCEL.1,
         gyro_fs: GYRO.1,
         mag_bits: MAG.1,
-        asa: margemu_firmware::chip::Config::default().asa,
+        asa: margemu_protocol::regmap::ak8963::EMULATED_ASA,
         gyro_offset: [0; 3],
         accel_offset: [0; 3],
+    }
+}
+
+/// [`image_config`] as the chip boundary's settings of an MPU-9250.
+pub fn chip_settings() -> margemu_protocol::chip::ChipSettings {
+    margemu_protocol::chip::ChipSettings {
+        model: margemu_protocol::chip::ChipModel::Mpu9250,
+        conversion: margemu_protocol::chip::Conversion::Mpu6xxx(image_config()),
     }
 }
 

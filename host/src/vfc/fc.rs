@@ -32,8 +32,12 @@ use crate::dut::mavlink_out::{attitude, attitude_quaternion, MavlinkWriter};
 use crate::loopback::Firmware;
 use crate::offline::ParamError;
 use margemu_filters::{AttitudeFilter, Diagnostics, Imu, Initial};
+use margemu_firmware::chip::EmulatedChip;
+use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion};
 use margemu_protocol::link::DeviceState;
-use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
+
+/// The virtual flight controller runs the `mpu9250` driver: it needs an MPU-9250.
+const NOT_AN_MPU9250: &str = "the virtual flight controller's driver needs an MPU-9250";
 use mavlink::dialects::common::{
     MavAutopilot, MavMessage, MavModeFlag, MavState, MavType, HEARTBEAT_DATA,
 };
@@ -79,7 +83,7 @@ impl FcReport {
 /// The flight controller: board, filter, output schedule, telemetry.
 pub struct VirtualFc {
     config: VfcConfig,
-    expected: ImageConfig,
+    expected: ChipSettings,
     board: Option<Board>,
     filter: Box<dyn AttitudeFilter<f64> + Send>,
     /// Instant of the previous sample filtered, ns.
@@ -100,7 +104,7 @@ impl VirtualFc {
     /// date.
     pub fn new(
         config: VfcConfig,
-        expected: ImageConfig,
+        expected: ChipSettings,
         uart: UartTx,
         report: Arc<Mutex<FcReport>>,
     ) -> Result<Self, ParamError> {
@@ -155,12 +159,15 @@ impl VirtualFc {
         let Some(board) = &mut self.board else {
             return Ok(());
         };
-        if !board.data_ready(device.chip()) {
+        let t_ns = device.last_served().map_or(0, |s| s.time_ns);
+        let EmulatedChip::Mpu6xxx(chip) = device.chip_mut() else {
+            return Err(NOT_AN_MPU9250.into());
+        };
+        if !board.data_ready(chip) {
             return Ok(());
         }
-        let t_ns = device.last_served().map_or(0, |s| s.time_ns);
         let m = board
-            .read(device.chip_mut())
+            .read(chip)
             .map_err(|e| format!("reading the chip: {e}"))?;
         let body = to_body(m.accel, m.gyro, m.mag, &self.config.mag_alignment);
         let period_ns = 1e9 / self.config.sample_rate_hz;
@@ -199,12 +206,19 @@ impl VirtualFc {
 
     /// Sets the device's chip up and checks its conversion against the host's prediction.
     fn set_up(&mut self, device: &mut Firmware) -> Result<Board, String> {
-        let (board, init) = Board::init(device.chip_mut(), self.config.sample_rate_hz)
+        let EmulatedChip::Mpu6xxx(chip) = device.chip_mut() else {
+            return Err(NOT_AN_MPU9250.into());
+        };
+        let (board, init) = Board::init(chip, self.config.sample_rate_hz)
             .map_err(|e| format!("setting the chip up through the mpu9250 driver: {e}"))?;
-        if init.image != self.expected {
+        let configured = ChipSettings {
+            model: ChipModel::Mpu9250,
+            conversion: Conversion::Mpu6xxx(init.image),
+        };
+        if configured != self.expected {
             return Err(format!(
                 "the driver configured the chip as {:?}, but the host computed its images for {:?}",
-                init.image, self.expected
+                configured.conversion, self.expected.conversion
             ));
         }
         self.filter = self

@@ -123,10 +123,10 @@ pub fn describe(params: &FilterParams) -> String {
 }
 
 /// The image settings for a chip the flight controller sets up: its full scales
-/// ([`board::image_config`]), otherwise those of [`ImageSettings::for_scene`].
+/// ([`board::chip_settings`]), otherwise those of [`ImageSettings::for_scene`].
 pub fn image_settings(scene: &Scene) -> ImageSettings {
     ImageSettings {
-        image: board::image_config(),
+        chip: board::chip_settings(),
         ..ImageSettings::for_scene(scene)
     }
 }

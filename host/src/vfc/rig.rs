@@ -17,7 +17,7 @@ use crate::dut::{DutConfig, DutError, DutProgress, DutProtocol, DutReader, DutSu
 use crate::loopback::{spawn_device_with_local, DeviceReport, LoopbackDevice};
 use crate::scene::Scene;
 use crate::stream::{Progress, Session, StreamConfig, StreamError, Summary};
-use margemu_protocol::regmap::mpu6xxx::image::ImageConfig;
+use margemu_protocol::chip::ChipSettings;
 use serialport::{SerialPort, TTYPort};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -91,12 +91,12 @@ impl VfcRig {
 
 /// Starts the firmware device on `device_port` with a flight controller of `config` in its
 /// thread; `expected` is the conversion the host computes images with
-/// ([`super::board::image_config`]). Returns the rig and the host end of the flight
+/// ([`super::board::chip_settings`]). Returns the rig and the host end of the flight
 /// controller's UART (a PTY with a 5 ms read timeout).
 pub fn spawn(
     device_port: TTYPort,
     config: VfcConfig,
-    expected: ImageConfig,
+    expected: ChipSettings,
 ) -> Result<(VfcRig, TTYPort), VfcError> {
     config
         .filter
@@ -237,7 +237,7 @@ pub fn run_loopback(
         ..stream
     };
     let mut session = Session::new(scene, stream, dir)?;
-    let expected = super::board::image_config();
+    let expected = super::board::chip_settings();
     let (rig, fc_port) = spawn(device_end, config, expected)?;
     let dut = match attach(
         &mut session,

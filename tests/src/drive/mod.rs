@@ -25,8 +25,8 @@ use std::time::Duration;
 use margemu::stream::JitterStats;
 use margemu_model::sensor::Truth;
 use margemu_protocol::link::{
-    Configure, Credit, Encoder, ErrorReport, HelloAck, Image, ImageBatch, KinematicsBatch, Message,
-    Rate, Telemetry, MAX_IMAGES_PER_BATCH, MAX_KINEMATICS_PER_BATCH,
+    max_images_per_batch, Configure, Credit, Encoder, ErrorReport, HelloAck, Image, ImageBatch,
+    KinematicsBatch, Message, Rate, Telemetry, MAX_KINEMATICS_PER_BATCH,
 };
 use serialport::TTYPort;
 
@@ -62,7 +62,7 @@ impl Samples<'_> {
 
     fn max_batch(&self) -> usize {
         match self {
-            Samples::Images(_) => MAX_IMAGES_PER_BATCH,
+            Samples::Images(s) => max_images_per_batch(s.first().map_or(1, |i| i.len())),
             Samples::Kinematics(_) => MAX_KINEMATICS_PER_BATCH,
         }
     }

@@ -1,0 +1,269 @@
+//! `[chip]`: which chip the device emulates for the scene, on which bus, and how it is mounted.
+//!
+//! ```toml
+//! [chip]
+//! model = "icm42688p"        # `margemu chips` lists them; default "mpu9250"
+//! bus = "spi"                # or "i2c"
+//! address = 0x69             # I2C only: one of the model's addresses (default its first)
+//! who_am_i = 0x47            # an identity variant of the model (default its own)
+//! rotation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]  # plate → chip axes
+//! accel_range = 16           # ± g, one of the model's full scales (default: power-on)
+//! gyro_range = 2000          # ± °/s
+//! ```
+//!
+//! A scene without `[chip]` keeps the MPU-9250 at its power-on settings, mounted with the
+//! plate's axes, at any output rate. A scene with `[chip]` must also run at one of the chip's own
+//! output rates. The rotation takes plate-frame vectors into the chip's axes (`v_chip = R·v_plate`)
+//! before the sensor model, so the model's error terms are in the chip's axes; it must be a proper
+//! rotation (orthonormal, determinant +1).
+
+use super::error::Violation;
+use margemu_protocol::chip::{ChipModel, ChipSettings, FullScale, SettingsError};
+use margemu_protocol::link::{Configure, Rate, RegisterOverride};
+use serde::Deserialize;
+
+/// A 3×3 matrix, row by row.
+pub type Rotation = [[f64; 3]; 3];
+
+/// The bus the device under test reads the chip on.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum BusKind {
+    /// SPI (mode 3, read flag 0x80).
+    #[default]
+    Spi,
+    /// I2C at [`ChipSpec::address`].
+    I2c,
+}
+
+impl BusKind {
+    /// The name in scene files and `meta.toml`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Spi => "spi",
+            Self::I2c => "i2c",
+        }
+    }
+}
+
+/// `[chip]` as written.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ChipSpec {
+    /// The model's name (`ChipModel::name`).
+    pub model: Option<String>,
+    /// The bus.
+    #[serde(default)]
+    pub bus: BusKind,
+    /// The 7-bit I2C address (I2C only).
+    pub address: Option<u8>,
+    /// The identity variant (WHO_AM_I value).
+    pub who_am_i: Option<u8>,
+    /// Plate → chip axes.
+    pub rotation: Option<Rotation>,
+    /// Accelerometer full scale, ± g.
+    pub accel_range: Option<f64>,
+    /// Gyroscope full scale, ± °/s.
+    pub gyro_range: Option<f64>,
+}
+
+/// The chip of a scene, resolved and checked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChipSetup {
+    /// The model.
+    pub model: ChipModel,
+    /// The identity it answers.
+    pub who_am_i: u8,
+    /// The bus the device under test uses.
+    pub bus: BusKind,
+    /// The chip's 7-bit I2C address.
+    pub i2c_address: u8,
+    /// Plate → chip axes; `None`: the plate's own.
+    pub rotation: Option<Rotation>,
+    /// The conversion settings the images are computed with.
+    pub settings: ChipSettings,
+}
+
+impl Default for ChipSetup {
+    /// The MPU-9250 at power-on on SPI, mounted with the plate's axes.
+    fn default() -> Self {
+        Self::power_on(ChipModel::Mpu9250)
+    }
+}
+
+impl ChipSetup {
+    /// `model` at power-on on SPI at its first address, mounted with the plate's axes.
+    pub fn power_on(model: ChipModel) -> Self {
+        Self {
+            model,
+            who_am_i: model.who_am_i(),
+            bus: BusKind::Spi,
+            i2c_address: model.i2c_addresses()[0],
+            rotation: None,
+            settings: ChipSettings::power_on(model),
+        }
+    }
+
+    /// The Configure of this chip at `rate` (the overrides set its full scales).
+    pub fn configure(&self, rate: Rate) -> Configure {
+        let mut cfg = Configure {
+            who_am_i: self.who_am_i,
+            i2c_address: self.i2c_address,
+            ..Configure::new(self.model, rate)
+        };
+        for (file, register, value) in self.settings.full_scale_writes() {
+            // At most two writes: always within MAX_OVERRIDES.
+            let _ = cfg.overrides.push(RegisterOverride {
+                file,
+                register,
+                value,
+            });
+        }
+        cfg
+    }
+
+    /// `v` (plate axes) in the chip's axes.
+    pub fn to_chip(&self, v: [f64; 3]) -> [f64; 3] {
+        match &self.rotation {
+            None => v,
+            Some(r) => core::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2]),
+        }
+    }
+}
+
+/// The names of every model, for messages.
+pub fn model_names() -> String {
+    let names: Vec<&str> = ChipModel::ALL.iter().map(|m| m.name()).collect();
+    names.join(", ")
+}
+
+fn hexes(values: &[u8]) -> String {
+    let v: Vec<String> = values.iter().map(|v| format!("{v:#04x}")).collect();
+    v.join(", ")
+}
+
+fn ranges(values: impl Iterator<Item = f64>) -> String {
+    let v: Vec<String> = values.map(|v| v.to_string()).collect();
+    v.join(", ")
+}
+
+/// Resolves `[chip]` (absent: the default MPU-9250) and checks it against the scene's `rate`.
+pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, Violation> {
+    let Some(spec) = spec else {
+        return Ok(ChipSetup::default());
+    };
+    let model = match &spec.model {
+        None => ChipModel::Mpu9250,
+        Some(name) => ChipModel::from_name(name).ok_or_else(|| {
+            Violation::at(
+                &["chip", "model"],
+                format!("no chip model {name:?}; margemu emulates {}", model_names()),
+            )
+        })?,
+    };
+    let part = model.part_name();
+    let who_am_i = spec.who_am_i.unwrap_or(model.who_am_i());
+    if !model.identities().contains(&who_am_i) {
+        return Err(Violation::at(
+            &["chip", "who_am_i"],
+            format!(
+                "the {part} answers {}, not {who_am_i:#04x}",
+                hexes(model.identities())
+            ),
+        ));
+    }
+    if !model.buses().contains(match spec.bus {
+        BusKind::Spi => margemu_protocol::link::Buses::SPI,
+        BusKind::I2c => margemu_protocol::link::Buses::I2C,
+    }) {
+        return Err(Violation::at(
+            &["chip", "bus"],
+            format!("the {part} has no {} bus", spec.bus.name()),
+        ));
+    }
+    let i2c_address = match (spec.bus, spec.address) {
+        (_, None) => model.i2c_addresses()[0],
+        (BusKind::Spi, Some(_)) => {
+            return Err(Violation::at(
+                &["chip", "address"],
+                "an address applies to bus = \"i2c\" only",
+            ))
+        }
+        (BusKind::I2c, Some(a)) if model.i2c_addresses().contains(&a) => a,
+        (BusKind::I2c, Some(a)) => {
+            return Err(Violation::at(
+                &["chip", "address"],
+                format!(
+                    "the {part} answers I2C at {}, not {a:#04x}",
+                    hexes(model.i2c_addresses())
+                ),
+            ))
+        }
+    };
+    if let Some(r) = &spec.rotation {
+        check_rotation(r)?;
+    }
+    let power_on = ChipSettings::power_on(model).full_scale();
+    let fs = FullScale {
+        accel_g: spec.accel_range.unwrap_or(power_on.accel_g),
+        gyro_dps: spec.gyro_range.unwrap_or(power_on.gyro_dps),
+    };
+    let settings = ChipSettings::with_full_scale(model, fs).map_err(|e| match e {
+        SettingsError::AccelRange(g) => Violation::at(
+            &["chip", "accel_range"],
+            format!(
+                "the {part} has no ±{g} g range; its ranges are ± {} g",
+                ranges(ChipSettings::accel_ranges_g(model))
+            ),
+        ),
+        SettingsError::GyroRange(dps) => Violation::at(
+            &["chip", "gyro_range"],
+            format!(
+                "the {part} has no ±{dps} °/s range; its ranges are ± {} °/s",
+                ranges(ChipSettings::gyro_ranges_dps(model))
+            ),
+        ),
+    })?;
+    if !model.has_output_rate(rate) {
+        return Err(Violation::at(
+            &["rate"],
+            format!(
+                "{rate} Hz is not an output rate of the {part} ([chip] model = {:?})",
+                model.name()
+            ),
+        ));
+    }
+    Ok(ChipSetup {
+        model,
+        who_am_i,
+        bus: spec.bus,
+        i2c_address,
+        rotation: spec.rotation,
+        settings,
+    })
+}
+
+fn check_rotation(r: &Rotation) -> Result<(), Violation> {
+    let bad = |why: &str| Violation::at(&["chip", "rotation"], why.to_owned());
+    if r.iter().flatten().any(|x| !x.is_finite()) {
+        return Err(bad("every element must be finite"));
+    }
+    for i in 0..3 {
+        for j in 0..3 {
+            let dot: f64 = (0..3).map(|k| r[i][k] * r[j][k]).sum();
+            let want = if i == j { 1.0 } else { 0.0 };
+            if (dot - want).abs() > 1e-6 {
+                return Err(bad(
+                    "is not orthonormal (rows must be unit vectors at right angles)",
+                ));
+            }
+        }
+    }
+    let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+        - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+        + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    if det < 0.0 {
+        return Err(bad("is a reflection (determinant −1), not a rotation"));
+    }
+    Ok(())
+}
