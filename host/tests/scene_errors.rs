@@ -157,3 +157,77 @@ fn a_missing_file_is_named() {
         "{e}"
     );
 }
+
+/// `[chip]`: an unknown model, a bus or address the chip lacks, an identity, full scale or
+/// output rate it does not have, and a rotation that is not one are refused where they are.
+#[test]
+fn chip_table_errors_are_located() {
+    let chip = |body: &str| format!("{BASE}[chip]\n{body}");
+    assert_error(
+        &chip("model = \"bmi999\"\n"),
+        "5:9",
+        "no chip model \"bmi999\"; margemu emulates mpu9250, mpu6500, mpu6000, icm20602, icm42688p",
+    );
+    assert_error(&chip("bus = \"can\"\n"), "5:7", "unknown variant `can`");
+    assert_error(
+        &chip("model = \"icm42688p\"\nbus = \"i2c\"\naddress = 0x0C\n"),
+        "7:11",
+        "the ICM-42688-P answers I2C at 0x68, 0x69, not 0x0c",
+    );
+    assert_error(
+        &chip("model = \"mpu6000\"\naddress = 0x69\n"),
+        "6:11",
+        "an address applies to bus = \"i2c\" only",
+    );
+    assert_error(
+        &chip("model = \"mpu6000\"\nwho_am_i = 0x71\n"),
+        "6:12",
+        "the MPU-6000 answers 0x68, not 0x71",
+    );
+    assert_error(
+        &chip("model = \"mpu9250\"\naccel_range = 3\n"),
+        "6:15",
+        "the MPU-9250 has no ±3 g range; its ranges are ± 2, 4, 8, 16 g",
+    );
+    assert_error(
+        &chip("gyro_range = 4000\n"),
+        "5:14",
+        "the MPU-9250 has no ±4000 °/s range",
+    );
+    assert_error(
+        &chip("rotation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]\n"),
+        "5:12",
+        "is a reflection",
+    );
+    assert_error(
+        &chip("rotation = [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 1.0]]\n"),
+        "5:12",
+        "is not orthonormal",
+    );
+    assert_error(
+        "duration = 1.0\nrate = 300.0\nseed = 1\n[chip]\nmodel = \"icm42688p\"\n",
+        "2:8",
+        "300 Hz is not an output rate of the ICM-42688-P",
+    );
+}
+
+#[test]
+fn chip_table_resolves_with_defaults() {
+    use margemu_protocol::chip::ChipModel;
+    let scene = Scene::parse_str(BASE, Path::new("plain.toml")).unwrap();
+    assert_eq!(scene.chip.model, ChipModel::Mpu9250);
+    let text = format!(
+        "{BASE}[chip]\nmodel = \"ICM-42688-P\"\nbus = \"i2c\"\naddress = 0x69\n\
+         accel_range = 4\ngyro_range = 500\n\
+         rotation = [[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]\n"
+    );
+    let scene = Scene::parse_str(&text, Path::new("icm.toml")).unwrap();
+    let chip = scene.chip;
+    assert_eq!(
+        (chip.model, chip.who_am_i, chip.i2c_address),
+        (ChipModel::Icm42688p, 0x47, 0x69)
+    );
+    let fs = chip.settings.full_scale();
+    assert_eq!((fs.accel_g, fs.gyro_dps), (4.0, 500.0));
+    assert_eq!(chip.to_chip([1.0, 2.0, 3.0]), [2.0, 1.0, -3.0]);
+}

@@ -4,7 +4,7 @@
 //! `--dut PORT` a device under test's output is logged beside the session; with `--vfc FILTER`
 //! a virtual flight controller runs on the emulated chip and its MAVLink is read back and scored.
 
-use super::stream::{finish_dut, prepare, stream_to, DutArgs, SourceArgs};
+use super::stream::{finish_dut, prepare, stream_to, ChipArgs, DutArgs, SourceArgs};
 use super::vfc::VfcArgs;
 use anyhow::{bail, Context, Result};
 use margemu::dut::{DutConfig, DutProtocol};
@@ -21,6 +21,8 @@ pub struct Cmd {
     #[arg(short, long)]
     output: Option<PathBuf>,
     #[command(flatten)]
+    chip: ChipArgs,
+    #[command(flatten)]
     source: SourceArgs,
     #[command(flatten)]
     dut: DutArgs,
@@ -30,7 +32,7 @@ pub struct Cmd {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = Scene::load(&self.scene)?;
+        let scene = self.chip.apply(Scene::load(&self.scene)?)?;
         let dir = self.output.clone().unwrap_or_else(|| {
             let stem = self.scene.file_stem().unwrap_or_default().to_string_lossy();
             PathBuf::from("sessions").join(format!("{stem}-loopback"))

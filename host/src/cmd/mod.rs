@@ -3,6 +3,7 @@
 pub mod analyze;
 pub mod bench;
 mod bench_stream;
+pub mod chips;
 pub mod demo;
 pub mod evaluate;
 pub mod filter;
@@ -34,6 +35,8 @@ pub enum Command {
     Stream(stream::Cmd),
     /// List serial ports.
     Ports(ports::Cmd),
+    /// List the emulated chips: identities, buses, full scales, rates, what is emulated.
+    Chips(chips::Cmd),
     /// Score a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned.
     Evaluate(evaluate::Cmd),
     /// The paper's case study through loopback with the virtual flight controller: Table 3.
@@ -54,6 +57,7 @@ impl Command {
             Command::Analyze(c) => c.run(),
             Command::Stream(c) => c.run(),
             Command::Ports(c) => c.run(),
+            Command::Chips(c) => c.run(),
             Command::Evaluate(c) => c.run(),
             Command::Demo(c) => c.run(),
             Command::Filter(c) => c.run(),

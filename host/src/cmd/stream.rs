@@ -35,9 +35,32 @@ pub struct Cmd {
     #[arg(long)]
     mag_ut_per_unit: Option<f64>,
     #[command(flatten)]
+    chip: ChipArgs,
+    #[command(flatten)]
     source: SourceArgs,
     #[command(flatten)]
     dut: DutArgs,
+}
+
+/// Which chip the device emulates.
+#[derive(clap::Args)]
+pub struct ChipArgs {
+    /// Emulate this chip model instead of the scene's `[chip]` (power-on settings, on SPI);
+    /// `margemu chips` lists them.
+    #[arg(long, value_name = "MODEL")]
+    chip: Option<String>,
+}
+
+impl ChipArgs {
+    /// `scene` with `--chip` applied.
+    pub fn apply(&self, scene: Scene) -> Result<Scene> {
+        match &self.chip {
+            None => Ok(scene),
+            Some(name) => {
+                margemu::scene::chip::with_model(&scene, name).map_err(anyhow::Error::msg)
+            }
+        }
+    }
 }
 
 /// The device under test's own output port.
@@ -113,7 +136,7 @@ impl SourceArgs {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = Scene::load(&self.scene)?;
+        let scene = self.chip.apply(Scene::load(&self.scene)?)?;
         let dir = self.output.clone().unwrap_or_else(|| {
             let stem = self.scene.file_stem().unwrap_or_default();
             PathBuf::from("sessions").join(stem)

@@ -189,11 +189,7 @@ pub fn read_sent(path: &Path, meta: &SessionMeta) -> Result<super::input::Imu, C
         let len = meta.chip.model.image_len();
         let decoded = parse_image_hex(text, len).and_then(|bytes| decode(&bytes, meta));
         let Some((acc, mag)) = decoded else {
-            return Err(row.error(format!(
-                "`image` = {text:?} is not {} hex digits (a {} image)",
-                2 * len,
-                meta.chip.model.part_name()
-            )));
+            return Err(row.error(format!("`image` = {text:?} is not {} hex digits", 2 * len)));
         };
         imu.t_ns.push(t_ns);
         imu.acc.push(acc);

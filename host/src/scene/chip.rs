@@ -131,6 +131,27 @@ impl ChipSetup {
     }
 }
 
+/// `scene` with its chip replaced by `name` at power-on on SPI (the scene's rotation kept), as
+/// `--chip` asks; an error names an unknown model or a scene rate the chip cannot output.
+pub fn with_model(scene: &super::Scene, name: &str) -> Result<super::Scene, String> {
+    let model = ChipModel::from_name(name)
+        .ok_or_else(|| format!("no chip model {name:?}; margemu emulates {}", model_names()))?;
+    let rate = scene.spec.rate;
+    if !model.has_output_rate(rate) {
+        return Err(format!(
+            "the {} cannot output the scene's {rate} Hz (`margemu chips {}` lists its rates)",
+            model.part_name(),
+            model.name()
+        ));
+    }
+    let mut scene = scene.clone();
+    scene.chip = ChipSetup {
+        rotation: scene.chip.rotation,
+        ..ChipSetup::power_on(model)
+    };
+    Ok(scene)
+}
+
 /// The names of every model, for messages.
 pub fn model_names() -> String {
     let names: Vec<&str> = ChipModel::ALL.iter().map(|m| m.name()).collect();

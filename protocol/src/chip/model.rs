@@ -142,6 +142,44 @@ impl ChipModel {
         matches!(self, Self::Mpu9250)
     }
 
+    /// What the emulation covers, for `margemu chips` (one line per item; the chip module's
+    /// docs give the datasheet sections).
+    pub const fn emulated(self) -> &'static [&'static str] {
+        match self.family() {
+            Family::Mpu6xxx => &[
+                "every register with its reset value, write mask and read-back",
+                "SPI (read flag 0x80) and I2C targets, burst auto-increment, FIFO and DMP ports",
+                "accel, gyro and temperature data at the configured full scales, user offsets",
+                "sample rate from SMPLRT_DIV, DLPF_CFG and FCHOICE; the accelerometer's own rate",
+                "FIFO with its count latch, overflow and the FIFO_EN sources",
+                "INT pin: data ready, FIFO overflow, pulse or latched, polarity, open drain",
+                "device reset, SIGNAL_PATH_RESET, USER_CTRL resets, sleep and clock select",
+            ],
+            Family::Icm42688p => &[
+                "register banks 0-4 with reset values, write masks and read-back",
+                "SPI (read flag 0x80) and I2C targets; FIFO_DATA does not auto-increment",
+                "soft reset with RESET_DONE; PWR_MGMT0 modes (a sensor that is off reads -32768)",
+                "16-bit data at the configured full scales, either endianness (INTF_CONFIG0)",
+                "FIFO: 8-, 16- and 20-byte packets with headers, 20-bit data, timestamps,                  count in bytes or records, lost packets, overflow, watermark",
+                "INT1/INT2: data ready, FIFO threshold and full, reset done; pulse or latched",
+            ],
+        }
+    }
+
+    /// What it does not emulate (yet), for `margemu chips`.
+    pub const fn not_emulated(self) -> &'static [&'static str] {
+        match self.family() {
+            Family::Mpu6xxx => &[
+                "the digital low-pass filters' effect on the data (settings are stored)",
+                "self-test responses, wake-on-motion, the DMP, FSYNC",
+            ],
+            Family::Icm42688p => &[
+                "the anti-alias and UI filters' effect on the data (settings are stored)",
+                "APEX motion features, self-test, external clock (CLKIN), FSYNC",
+            ],
+        }
+    }
+
     /// Bytes of one register image of this model (see each chip module's `image`).
     pub const fn image_len(self) -> usize {
         match self {

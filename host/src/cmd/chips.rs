@@ -1,0 +1,104 @@
+//! `margemu chips`: every chip model margemu emulates, with what a scene's `[chip]` table may
+//! choose (identity, bus, address, full scales, output rates) and what is and is not emulated.
+
+use anyhow::Result;
+use margemu_protocol::chip::{ChipModel, ChipSettings};
+
+#[derive(clap::Args)]
+pub struct Cmd {
+    /// Only this model (`margemu chips icm42688p`).
+    model: Option<String>,
+}
+
+impl Cmd {
+    pub fn run(self) -> Result<()> {
+        let models: Vec<ChipModel> = match &self.model {
+            None => ChipModel::ALL.to_vec(),
+            Some(name) => vec![ChipModel::from_name(name).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "no chip model {name:?}; margemu emulates {}",
+                    margemu::scene::chip::model_names()
+                )
+            })?],
+        };
+        for (i, model) in models.into_iter().enumerate() {
+            if i > 0 {
+                println!();
+            }
+            print!("{}", describe(model));
+        }
+        Ok(())
+    }
+}
+
+fn list(values: impl Iterator<Item = String>) -> String {
+    values.collect::<Vec<_>>().join(", ")
+}
+
+/// The description `margemu chips` prints for `model`.
+pub fn describe(model: ChipModel) -> String {
+    let hex = |v: &[u8]| list(v.iter().map(|b| format!("{b:#04x}")));
+    let power_on = ChipSettings::power_on(model).full_scale();
+    let mut out = format!(
+        "{} ([chip] model = \"{}\")\n",
+        model.part_name(),
+        model.name()
+    );
+    out += &format!("  WHO_AM_I:     {}\n", hex(model.identities()));
+    out += &format!(
+        "  buses:        SPI, I2C at {}\n",
+        hex(model.i2c_addresses())
+    );
+    out += &format!(
+        "  accel ranges: ± {} g (power-on ±{} g)\n",
+        list(ChipSettings::accel_ranges_g(model).map(|g| g.to_string())),
+        power_on.accel_g
+    );
+    out += &format!(
+        "  gyro ranges:  ± {} °/s (power-on ±{} °/s)\n",
+        list(ChipSettings::gyro_ranges_dps(model).map(|d| d.to_string())),
+        power_on.gyro_dps
+    );
+    out += &format!("  output rates: {}\n", rates(model));
+    out += &format!(
+        "  magnetometer: {}\n",
+        if model.has_magnetometer() {
+            "AK8963 behind the auxiliary I2C master or in bypass at 0x0c"
+        } else {
+            "none"
+        }
+    );
+    out += &format!(
+        "  image:        {} bytes per sample on the link\n",
+        model.image_len()
+    );
+    out += "  emulated:\n";
+    for item in model.emulated() {
+        out += &format!("    - {item}\n");
+    }
+    out += "  not emulated:\n";
+    for item in model.not_emulated() {
+        out += &format!("    - {item}\n");
+    }
+    out
+}
+
+/// The output rates of `model` in words.
+fn rates(model: ChipModel) -> String {
+    let candidates = [
+        32_000.0, 16_000.0, 8_000.0, 4_000.0, 2_000.0, 1_000.0, 500.0, 200.0, 100.0, 50.0, 25.0,
+        12.5,
+    ];
+    let listed = list(
+        candidates
+            .iter()
+            .filter(|r| model.has_output_rate(**r))
+            .map(|r| format!("{r} Hz")),
+    );
+    match model.family() {
+        margemu_protocol::chip::Family::Mpu6xxx => {
+            format!("{listed}, and 8 kHz or 1 kHz / (1 + SMPLRT_DIV)")
+        }
+        margemu_protocol::chip::Family::Icm42688p => listed,
+    }
+}
