@@ -95,10 +95,9 @@ fn rates(model: ChipModel) -> String {
             .filter(|r| model.has_output_rate(**r))
             .map(|r| format!("{r} Hz")),
     );
-    match model.family() {
-        margemu_protocol::chip::Family::Mpu6xxx => {
-            format!("{listed}, and 8 kHz or 1 kHz / (1 + SMPLRT_DIV)")
-        }
-        margemu_protocol::chip::Family::Icm42688p => listed,
+    match model {
+        ChipModel::Mpu6000 => format!("{listed}, … (8 kHz or 1 kHz / (1 + SMPLRT_DIV))"),
+        ChipModel::Icm42688p => listed,
+        _ => format!("{listed}, … (32 kHz, 8 kHz, or 1 kHz / (1 + SMPLRT_DIV))"),
     }
 }

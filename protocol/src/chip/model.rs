@@ -192,18 +192,19 @@ impl ChipModel {
     }
 
     /// Whether the part can output samples at `rate_hz` (within 1e-9 relative): the rates its
-    /// rate registers give (InvenSense 6xxx: 8 kHz or 1 kHz divided by 1 + SMPLRT_DIV, and
-    /// 32 kHz with the DLPF bypassed; ICM-42688-P: its ODR codes).
+    /// rate registers give. MPU-6000: the gyro output rate (8 kHz with the DLPF off, 1 kHz on)
+    /// divided by 1 + SMPLRT_DIV (RM-MPU-6000A section 4.2). MPU-6500, MPU-9250, ICM-20602:
+    /// 32 kHz (FCHOICE_B), 8 kHz (DLPF_CFG 0 or 7), or 1 kHz / (1 + SMPLRT_DIV) (the divider
+    /// applies only with the DLPF on; RM-MPU-9250A section 4.4). ICM-42688-P: its ODR codes.
     pub fn has_output_rate(self, rate_hz: f64) -> bool {
         let close = |r: f64| (r - rate_hz).abs() <= 1e-9 * r;
-        match self.family() {
-            Family::Mpu6xxx => {
-                close(32_000.0)
-                    || (0..=255u32).any(|div| {
-                        close(8_000.0 / f64::from(div + 1)) || close(1_000.0 / f64::from(div + 1))
-                    })
+        let divided = |base: f64| (1..=256u32).any(|n| close(base / f64::from(n)));
+        match self {
+            Self::Mpu6000 => divided(8_000.0) || divided(1_000.0),
+            Self::Mpu9250 | Self::Mpu6500 | Self::Icm20602 => {
+                close(32_000.0) || close(8_000.0) || divided(1_000.0)
             }
-            Family::Icm42688p => ICM42688P_ODRS_HZ.iter().any(|&r| close(r)),
+            Self::Icm42688p => ICM42688P_ODRS_HZ.iter().any(|&r| close(r)),
         }
     }
 }
