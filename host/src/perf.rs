@@ -180,9 +180,10 @@ pub fn stream_scene(rate_hz: f64, seconds: f64) -> Scene {
     Scene::parse_str(&text, std::path::Path::new("bench-stream.toml")).expect("a valid scene")
 }
 
-/// Streams [`stream_scene`] at each rate and source through the loopback device, writing each
-/// session's logs under `dir`.
+/// Streams [`stream_scene`] with `chip` (at power-on; any rate, to find the link's limits)
+/// at each rate and source through the loopback device, writing each session's logs under `dir`.
 pub fn stream_sweep(
+    chip: margemu_protocol::chip::ChipModel,
     rates: &[f64],
     sources: &[SourceMode],
     seconds: f64,
@@ -191,7 +192,8 @@ pub fn stream_sweep(
     let mut rows = Vec::new();
     for &source in sources {
         for &rate_hz in rates {
-            let scene = stream_scene(rate_hz, seconds);
+            let mut scene = stream_scene(rate_hz, seconds);
+            scene.chip = crate::scene::chip::ChipSetup::power_on(chip);
             let mode = match source {
                 SourceMode::Images => "images",
                 SourceMode::Model { .. } => "model",

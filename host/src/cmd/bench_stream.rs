@@ -3,6 +3,7 @@
 use anyhow::Result;
 use margemu::perf::{link_table, stream_sweep, StreamRow};
 use margemu::stream::{JitterStats, SourceMode};
+use margemu_protocol::chip::ChipModel;
 use std::path::PathBuf;
 
 const BAUDS: [u32; 3] = [921_600, 2_000_000, 3_000_000];
@@ -23,6 +24,9 @@ pub struct Cmd {
     /// Without it they go to a temporary directory, removed after each row.
     #[arg(long)]
     keep: Option<PathBuf>,
+    /// The chip model the device emulates (power-on settings; `margemu chips` lists them).
+    #[arg(long, default_value = "mpu9250")]
+    chip: String,
 }
 
 impl Cmd {
@@ -31,6 +35,13 @@ impl Cmd {
             self.seconds > 0.0 && self.rates.iter().all(|r| *r > 0.0),
             "--seconds and --rates must be > 0"
         );
+        let chip = ChipModel::from_name(&self.chip).ok_or_else(|| {
+            anyhow::anyhow!(
+                "no chip model {:?}; margemu emulates {}",
+                self.chip,
+                margemu::scene::chip::model_names()
+            )
+        })?;
         let sources = [
             SourceMode::Images,
             SourceMode::Model {
@@ -38,13 +49,15 @@ impl Cmd {
             },
         ];
         println!(
-            "Each row streams a {} s kinematic scene (noise on every sensor) in real time through a \
-             PTY pair to the firmware's link handler (loopback device, buffer {} samples), and checks \
+            "Each row streams a {} s kinematic scene (noise on every sensor, an emulated {}, {} B \
+             images) in real time through a PTY pair to the firmware's link handler (loopback device, buffer {} samples), and checks \
              the CRC-32C of every image it served against the host's prediction. Lost = scene \
              samples not served byte for byte (underruns, mismatches, unreported). Pacing: how \
              late each batch's write started against the scene clock; written: how late it \
              completed (the PTY write included).\n",
             self.seconds,
+            chip.part_name(),
+            chip.image_len(),
             margemu::loopback::BUFFER,
         );
         println!(
@@ -56,7 +69,7 @@ impl Cmd {
         });
         for &source in &sources {
             for &rate in &self.rates {
-                let row = stream_sweep(&[rate], &[source], self.seconds, &dir)?;
+                let row = stream_sweep(chip, &[rate], &[source], self.seconds, &dir)?;
                 if self.keep.is_none() {
                     std::fs::remove_dir_all(&dir)?;
                 }
