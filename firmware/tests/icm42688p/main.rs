@@ -15,6 +15,7 @@ mod fc_betaflight;
 mod fc_px4;
 mod fifo;
 mod interrupts;
+mod random_sequences;
 mod resets;
 
 use margemu_firmware::chip::{I2cTarget, Icm42688p, PhysicalSample, SpiTarget};

@@ -68,10 +68,14 @@ impl Fifo {
 
     /// Empties the FIFO and its history (flush, reset).
     pub(super) fn flush(&mut self) {
-        *self = Self {
-            buf: self.buf,
-            ..Self::new()
-        };
+        self.head = 0;
+        self.len = 0;
+        self.lens_head = 0;
+        self.packets = 0;
+        self.cursor = 0;
+        self.lost = 0;
+        self.last_odr = None;
+        self.last_time_ns = None;
     }
 
     /// Unread bytes.
