@@ -70,6 +70,15 @@ fn i2c_address_pointer_and_bursts() {
 }
 
 #[test]
+fn ui_sifs_cfg_11_disables_i2c() {
+    let mut c = chip();
+    spi_write(&mut c, 0x4C, &[0x33]);
+    assert_eq!(i2c_read(&mut c, 0x68, 0x75, 1), None);
+    spi_write(&mut c, 0x4C, &[0x30]);
+    assert_eq!(i2c_read(&mut c, 0x68, 0x75, 1), Some(vec![0x47]));
+}
+
+#[test]
 fn i2c_fifo_reads_stay_on_fifo_data() {
     let mut c = running();
     spi_write(&mut c, 0x5F, &[0x02]);

@@ -6,7 +6,8 @@
 //! in REG_BANK_SEL writes); AFSR off. Then it polls at the backend rate: FIFO_COUNTH/L (2
 //! bytes, little-endian records), FIFO_DATA in reads of at most 2 × 16-byte packets, each
 //! header checked with `(header & 0xFC) == 0x68` (a bad one resets the FIFO), and after every
-//! poll one read-back of the next register it wrote.
+//! poll one read-back of the next bank-0 register it wrote (its checked registers are read
+//! without a bank switch).
 
 use super::fc::{assert_complete, Decoded, Recorder, Rig, Run};
 use super::*;

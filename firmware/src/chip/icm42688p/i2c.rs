@@ -1,9 +1,11 @@
 //! The I2C target (DS section 9.3): address 0x68 | AD0; the first byte written after a START
 //! sets the register pointer, further bytes write and move it on; reads start at the pointer
 //! and move it on (within the selected bank, not on FIFO_DATA), across repeated STARTs. A data
-//! sample waiting for the bus appears at STOP.
+//! sample waiting for the bus appears at STOP. INTF_CONFIG0.UI_SIFS_CFG = 11 (I2C disabled, as
+//! PX4 sets it on SPI boards) makes the chip ignore its address; UI_SIFS_CFG = 10 (SPI
+//! disabled) is stored only.
 
-use margemu_protocol::regmap::icm42688p::next_address;
+use margemu_protocol::regmap::icm42688p::{bank0, next_address};
 
 use super::super::{Bus, I2cTarget};
 use super::Icm42688p;
@@ -29,7 +31,8 @@ impl I2cState {
 impl I2cTarget for Icm42688p {
     fn start(&mut self, address: u8, read: bool) -> bool {
         self.i2c.active = true;
-        self.i2c.addressed = address == self.i2c_address();
+        let i2c_disabled = self.peek(0, bank0::INTF_CONFIG0) & 0x03 == 0x03;
+        self.i2c.addressed = address == self.i2c_address() && !i2c_disabled;
         self.i2c.pointer_next = !read;
         self.i2c.addressed
     }

@@ -144,9 +144,9 @@ pub mod bank1 {
     pub const GYRO_CONFIG_STATIC2: u8 = 0x0B;
     /// GYRO_AAF_DELT.
     pub const GYRO_CONFIG_STATIC3: u8 = 0x0C;
-    /// GYRO_AAF_DELTSQR[7:0].
+    /// GYRO_AAF_DELTSQR bits 7:0.
     pub const GYRO_CONFIG_STATIC4: u8 = 0x0D;
-    /// GYRO_AAF_BITSHIFT, GYRO_AAF_DELTSQR[11:8].
+    /// GYRO_AAF_BITSHIFT, GYRO_AAF_DELTSQR bits 11:8.
     pub const GYRO_CONFIG_STATIC5: u8 = 0x0E;
     /// Notch X coefficient (factory trim).
     pub const GYRO_CONFIG_STATIC6: u8 = 0x0F;
@@ -178,9 +178,9 @@ pub mod bank1 {
 pub mod bank2 {
     /// ACCEL_AAF_DELT (6:1), ACCEL_AAF_DIS (0).
     pub const ACCEL_CONFIG_STATIC2: u8 = 0x03;
-    /// ACCEL_AAF_DELTSQR[7:0].
+    /// ACCEL_AAF_DELTSQR bits 7:0.
     pub const ACCEL_CONFIG_STATIC3: u8 = 0x04;
-    /// ACCEL_AAF_BITSHIFT, ACCEL_AAF_DELTSQR[11:8].
+    /// ACCEL_AAF_BITSHIFT, ACCEL_AAF_DELTSQR bits 11:8.
     pub const ACCEL_CONFIG_STATIC4: u8 = 0x05;
     /// Accel X self-test data (factory).
     pub const XA_ST_DATA: u8 = 0x3B;
