@@ -1,5 +1,5 @@
-//! SPI bursts across banks, I2C addressing and bursts, and the write log (DS sections 9.3,
-//! 9.6).
+//! SPI bursts across banks, I2C addressing and bursts, and the write log (DS: I2C and SPI
+//! interfaces).
 
 use super::*;
 use margemu_firmware::chip::icm42688p::Config;

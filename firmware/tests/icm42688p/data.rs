@@ -1,5 +1,6 @@
 //! Data registers: power modes and −32768, full scales, endianness, the atomic swap, sample
-//! periods (DS sections 14.7–14.9, 14.21–14.25).
+//! periods (DS 4.11, 4.16, PWR_MGMT0,
+//! GYRO_CONFIG0, ACCEL_CONFIG0, INTF_CONFIG0).
 
 use super::*;
 

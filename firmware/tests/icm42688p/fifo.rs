@@ -1,5 +1,5 @@
 //! FIFO packets byte for byte, counts in bytes or records, overflow and lost packets, flush,
-//! partial reads, timestamps and the 8-bit temperature (DS section 6).
+//! partial reads, timestamps and the 8-bit temperature (DS: FIFO).
 
 use super::*;
 use margemu_protocol::regmap::icm42688p::image::ImageRepr;

@@ -1,5 +1,6 @@
 //! INT_STATUS, INT1/INT2: pulsed or latched, polarity, drive, pulse length and de-assertion,
-//! clear modes, FIFO threshold and full (DS sections 4.12, 14.4, 14.50–14.53).
+//! clear modes, FIFO threshold and full (DS 4.12 Interrupts,
+//! INT_CONFIG, INT_CONFIG0/1, INT_SOURCE0/3).
 
 use super::*;
 

@@ -1,4 +1,4 @@
-//! Reset values of every bank, soft reset, reserved registers and bits (DS sections 13–18).
+//! Reset values of every bank, soft reset, reserved registers and bits (DS register map).
 
 use super::*;
 

@@ -1,4 +1,4 @@
-//! The 2 KB FIFO (DS section 6: packet structure, FIFO_CONFIG, FIFO_CONFIG1–3, FIFO_COUNT,
+//! The 2 KB FIFO (DS: FIFO, packet structure, FIFO_CONFIG, FIFO_CONFIG1–3, FIFO_COUNT,
 //! FIFO_LOST_PKT).
 //!
 //! FIFO_CONFIG.FIFO_MODE 00 (bypass) pushes nothing; 01 (stream) drops the oldest whole packets

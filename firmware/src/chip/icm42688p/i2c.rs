@@ -1,4 +1,4 @@
-//! The I2C target (DS section 9.3): address 0x68 | AD0; the first byte written after a START
+//! The I2C target (DS: I2C interface): address 0x68 | AD0; the first byte written after a START
 //! sets the register pointer, further bytes write and move it on; reads start at the pointer
 //! and move it on (within the selected bank, not on FIFO_DATA), across repeated STARTs. A data
 //! sample waiting for the bus appears at STOP. INTF_CONFIG0.UI_SIFS_CFG = 11 (I2C disabled, as

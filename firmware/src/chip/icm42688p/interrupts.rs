@@ -1,4 +1,4 @@
-//! INT_STATUS and the INT1/INT2 pins (DS sections 4.12, 14.4, 14.50–14.53: INT_CONFIG,
+//! INT_STATUS and the INT1/INT2 pins (DS 4.12 Interrupts; INT_CONFIG,
 //! INT_CONFIG0, INT_CONFIG1, INT_SOURCE0, INT_SOURCE3).
 //!
 //! Every event sets its INT_STATUS bit (data ready, FIFO threshold, FIFO full, reset done),

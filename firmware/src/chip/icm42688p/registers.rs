@@ -1,4 +1,5 @@
-//! Register-file semantics shared by the SPI and I2C targets (DS sections 13–18): what a read
+//! Register-file semantics shared by the SPI and I2C targets (DS register map and
+//! descriptions): what a read
 //! returns and changes, what a write stores and triggers.
 //!
 //! As in the 6xxx family a bus read is split in two so the SPI target can prefetch one byte
@@ -10,7 +11,7 @@
 //!   INTF_CONFIG0.SENSOR_DATA_ENDIAN selects; FIFO_COUNTH/L in FIFO_COUNT_ENDIAN order, counting
 //!   bytes or records (FIFO_COUNT_REC).
 //! - INT_STATUS clears on read, except the bits INT_CONFIG0 sets to clear on a sensor-register
-//!   read (DATA_RDY) or on a FIFO byte read (FIFO_THS, FIFO_FULL) (DS section 14.50).
+//!   read (DATA_RDY) or on a FIFO byte read (FIFO_THS, FIFO_FULL) (DS: INT_CONFIG0).
 //! - DEVICE_CONFIG.SOFT_RESET_CONFIG: every bank to its reset values, RESET_DONE_INT set; the
 //!   write log is kept. SIGNAL_PATH_RESET.FIFO_FLUSH (and ABORT_AND_RESET) empty the FIFO.
 //! - Reserved addresses read 0 and ignore writes; reserved bits keep their reset value.

@@ -1,5 +1,6 @@
 //! One sample instant: conversion, sensors that are off, the FIFO packet, DATA_RDY_INT and the
-//! atomic swap of the data registers (DS sections 4.11, 6, 14.7–14.9).
+//! atomic swap of the data registers (DS 4.11 Sensor Data
+//! Registers, 4.16 Standard Power Modes, FIFO, PWR_MGMT0).
 //!
 //! A sensor that is off (PWR_MGMT0: gyro not in low-noise mode, accel not in a low-power or
 //! low-noise mode, temperature disabled or both off) reads −32768 (0x8000), in the data

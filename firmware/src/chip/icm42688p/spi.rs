@@ -1,4 +1,4 @@
-//! The SPI target state machine (DS section 9.6, 4-wire mode 0/3): the first byte after chip
+//! The SPI target state machine (DS: SPI interface, 4-wire mode 0/3): the first byte after chip
 //! select is `R/W̄ | address` (bit 7 set reads) in the bank REG_BANK_SEL selects; following
 //! bytes are data; bursts move to the next register except on FIFO_DATA, which stays.
 //!

@@ -2,14 +2,15 @@
 //!
 //! Every conversion scales, rounds to the nearest integer (halves away from zero) and
 //! saturates, through [`round_saturate`] / [`round_saturate_i32`] of the 6xxx family; NaN
-//! converts to 0. Sensitivities (DS sections 3.1–3.2, 4.13, 6.1):
+//! converts to 0. Sensitivities (DS: sensor specifications, 4.13 Digital-Output Temperature
+//! Sensor, FIFO packet structure):
 //! - 16-bit accel and gyro at the configured full scale ([`AccelFs`], [`GyroFs`]);
 //! - TEMP_DATA, 16 bits: °C = raw / 132.48 + 25;
 //! - FIFO temperature, 8 bits (packets 1–3): °C = raw / 2.07 + 25. 132.48 / 2.07 = 64, so the
 //!   8-bit value is the 16-bit one divided by 64 (rounded, saturated to i8): [`fifo_temp8`];
 //! - 20-bit FIFO data (packet 4), fixed at ±16 g and ±2000 °/s whatever the configured full
 //!   scale: accel carries 18 meaningful bits at 8192 LSB/g with the 2 low bits 0, gyro 19 bits
-//!   at 131 LSB/(°/s) with the low bit 0 (DS section 6.1; PX4 `ICM42688P.cpp` decodes them the
+//!   at 131 LSB/(°/s) with the low bit 0 (DS: FIFO packet structure; PX4 `ICM42688P.cpp` decodes them the
 //!   same way). The most negative 20-bit code, −524288, marks an invalid sample, so conversion
 //!   saturates one code above it.
 //!

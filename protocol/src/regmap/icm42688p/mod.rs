@@ -1,6 +1,9 @@
 //! The TDK InvenSense ICM-42688-P (accel + gyro + temperature): register addresses of user banks
 //! 0–4, bits, reset values, access masks, full scales and output rates (datasheet DS-000347
-//! rev. 1.7, "DS" below: section 13 register map, sections 14–18 register descriptions).
+//! rev. 1.7, "DS" below: the register map and the register descriptions of user banks 0–4).
+//! Sections are cited by title; the numbers we could check in rev. 1.7 are 4.11 Sensor Data
+//! Registers, 4.12 Interrupts, 4.13 Digital-Output Temperature Sensor, 4.16 Standard Power
+//! Modes, 5.3 Anti-Alias Filter and 5.5 UI Filter Block.
 //!
 //! Registers are named by `(bank, addr)`: REG_BANK_SEL (0x76, present in every bank) selects the
 //! bank that addresses 0x00..=0x7F reach. Addresses that the datasheet does not list are
@@ -8,10 +11,15 @@
 //! reset value ([`write_mask`]); read-only registers ignore writes ([`is_read_only`]); the
 //! action bits of DEVICE_CONFIG and SIGNAL_PATH_RESET read back 0 ([`self_clearing_mask`]).
 //!
-//! Reset values are the datasheet's (DS section 13); the factory-trimmed registers (gyro notch
+//! Reset values are the datasheet's (DS register map); the factory-trimmed registers (gyro notch
 //! coefficients GYRO_CONFIG_STATIC6..9 and the self-test data) hold the fixed values of this
 //! emulated part ([`FACTORY_TRIM`]). Bank 3 is not tabulated in the datasheet; only CLKDIV
 //! (0x2A, named by Zephyr's `icm42688_reg.h`) is kept, reset value 0x00 assumed.
+//!
+//! Write masks keep the bit fields the register descriptions name; where a description names
+//! none (bank 4 APEX, thresholds and offsets) every bit is writable. The reset values were
+//! cross-checked with register headers that transcribe the datasheet table (e.g. the
+//! `ICM42688.h` headers quoting "Serial IF … Reset value" per register).
 //!
 //! Cross-checked against Zephyr `drivers/sensor/tdk/icm42688/icm42688_reg.h` (Apache-2.0) and
 //! the register lists of PX4 `InvenSense_ICM42688P_registers.hpp`; no code was taken from them.
@@ -31,16 +39,16 @@ mod scale;
 
 pub use scale::{AccelFs, GyroFs, Odr};
 
-/// REG_BANK_SEL, at the same address in every bank (DS section 14.55).
+/// REG_BANK_SEL, at the same address in every bank (DS: REG_BANK_SEL).
 pub const REG_BANK_SEL: u8 = 0x76;
 
 /// Number of user banks (0..=4).
 pub const BANKS: u8 = 5;
 
-/// FIFO size in bytes (DS section 6: 2 KB).
+/// FIFO size in bytes (DS: FIFO, 2 KB).
 pub const FIFO_SIZE: usize = 2048;
 
-/// User bank 0 (DS section 14): configuration, data, FIFO and interrupts.
+/// User bank 0 (DS: user bank 0 register descriptions): configuration, data, FIFO and interrupts.
 pub mod bank0 {
     /// SPI_MODE (bit 4), SOFT_RESET_CONFIG (bit 0).
     pub const DEVICE_CONFIG: u8 = 0x11;
@@ -136,7 +144,7 @@ pub mod bank0 {
     pub const WHO_AM_I: u8 = 0x75;
 }
 
-/// User bank 1 (DS section 15): gyro notch and anti-alias filter, timestamp, interface.
+/// User bank 1 (DS: user bank 1): gyro notch and anti-alias filter, timestamp, interface.
 pub mod bank1 {
     /// Per-axis sensor disables.
     pub const SENSOR_CONFIG0: u8 = 0x03;
@@ -174,7 +182,7 @@ pub mod bank1 {
     pub const INTF_CONFIG6: u8 = 0x7C;
 }
 
-/// User bank 2 (DS section 16): accel anti-alias filter and self-test data.
+/// User bank 2 (DS: user bank 2): accel anti-alias filter and self-test data.
 pub mod bank2 {
     /// ACCEL_AAF_DELT (6:1), ACCEL_AAF_DIS (0).
     pub const ACCEL_CONFIG_STATIC2: u8 = 0x03;
@@ -194,7 +202,7 @@ pub mod bank3 {
     pub const CLKDIV: u8 = 0x2A;
 }
 
-/// User bank 4 (DS section 18): APEX, wake-on-motion thresholds, user offsets.
+/// User bank 4 (DS: user bank 4): APEX, wake-on-motion thresholds, user offsets.
 pub mod bank4 {
     /// APEX configuration 1 (first of nine).
     pub const APEX_CONFIG1: u8 = 0x40;
@@ -457,7 +465,7 @@ pub const fn is_read_only(bank: u8, addr: u8) -> bool {
 }
 
 /// The register a burst reaches after `addr`: the next one in the same bank (wrapping at 0x7F),
-/// except FIFO_DATA in bank 0, which a burst keeps reading (DS section 9.6).
+/// except FIFO_DATA in bank 0, which a burst keeps reading (DS: SPI interface).
 pub const fn next_address(bank: u8, addr: u8) -> u8 {
     if bank == 0 && addr == bank0::FIFO_DATA {
         addr
@@ -469,7 +477,7 @@ pub const fn next_address(bank: u8, addr: u8) -> u8 {
 /// Bytes of the data registers TEMP_DATA1..=GYRO_DATA_Z0 (0x1D..=0x2A).
 pub const DATA_LEN: usize = 14;
 
-/// Packet sizes in bytes (DS section 6.1): packets 1 and 2 (accel or gyro only), 3 (both,
+/// Packet sizes in bytes (DS: FIFO packet structure): packets 1 and 2 (accel or gyro only), 3 (both,
 /// 16-bit) and 4 (both, 20-bit).
 pub mod packet {
     /// Header, 6 data bytes, 8-bit temperature.

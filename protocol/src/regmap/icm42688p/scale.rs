@@ -1,5 +1,5 @@
-//! Full scales and output data rates (DS sections 3.1–3.2 and 14.25–14.26: GYRO_CONFIG0,
-//! ACCEL_CONFIG0).
+//! Full scales and output data rates (DS: gyroscope and accelerometer
+//! specifications; register descriptions of GYRO_CONFIG0 and ACCEL_CONFIG0).
 
 /// Accelerometer full scale, ACCEL_CONFIG0.ACCEL_FS_SEL (bits 7:5; codes 4–7 reserved, read as
 /// ±2 g here).
@@ -91,7 +91,7 @@ impl GyroFs {
         self as u8
     }
 
-    /// Sensitivity, LSB per °/s (DS table 1).
+    /// Sensitivity, LSB per °/s (DS: gyroscope specifications).
     pub const fn lsb_per_dps(self) -> f32 {
         match self {
             Self::Dps2000 => 16.4,
