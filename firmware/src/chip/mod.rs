@@ -22,17 +22,21 @@
 //! Chips:
 //! - [`Mpu6xxx`]: the InvenSense 6xxx family (the MPU-9250 and its WHO_AM_I variants) with the [`Ak8963`]
 //!   magnetometer behind its auxiliary I2C master or in bypass mode;
-//! - [`Ak8963`] on its own, as an [`I2cTarget`].
+//! - [`Ak8963`] on its own, as an [`I2cTarget`];
+//! - [`Icm42688p`]: the TDK InvenSense ICM-42688-P (banks 0–4, 2 KB FIFO with 16- and 20-bit
+//!   packets, INT1/INT2).
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
 mod ak8963;
 mod emulated;
+pub mod icm42688p;
 pub mod mpu6xxx;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
 pub use emulated::{Chip, EmulatedChip};
+pub use icm42688p::Icm42688p;
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 

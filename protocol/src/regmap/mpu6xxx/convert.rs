@@ -31,11 +31,21 @@ const DEG_PER_RAD: f64 = 180.0 / core::f64::consts::PI;
 
 /// `x` rounded to the nearest integer (halves away from zero), clamped to `[lo, hi]`; NaN → 0.
 pub fn round_saturate(x: f32, lo: i16, hi: i16) -> i16 {
+    round_saturate_i32(x, i32::from(lo), i32::from(hi)) as i16
+}
+
+/// [`round_saturate`] for registers wider than 16 bits (the ICM-42688-P's 18/19-bit FIFO data).
+/// Exact for bounds within ±2^24, where every integer is an `f32`; wider bounds are narrowed to
+/// that range.
+pub fn round_saturate_i32(x: f32, lo: i32, hi: i32) -> i32 {
+    const EXACT: i32 = 1 << 24;
+    let (a, b) = (lo.clamp(-EXACT, EXACT), hi.clamp(-EXACT, EXACT));
+    let (lo, hi) = (a.min(b), a.max(b)); // never panics, whatever the caller passes
     if x.is_nan() {
         return 0;
     }
     // Clamp first, so the float → int cast below is exact and far from i32's limits.
-    let x = x.clamp(f32::from(lo) - 1.0, f32::from(hi) + 1.0);
+    let x = x.clamp((lo - 1) as f32, (hi + 1) as f32);
     let truncated = x as i32; // toward zero; exact here
     let fraction = x - truncated as f32; // exact for |x| < 2^24
     let rounded = if fraction >= 0.5 {
@@ -45,7 +55,7 @@ pub fn round_saturate(x: f32, lo: i16, hi: i16) -> i16 {
     } else {
         truncated
     };
-    rounded.clamp(i32::from(lo), i32::from(hi)) as i16
+    rounded.clamp(lo, hi)
 }
 
 /// Accelerometer register value (ACCEL_xOUT) of a specific force `a` in m/s².
