@@ -19,6 +19,7 @@
 
 use margemu_protocol::chip::{ChipModel, ChipSettings, PhysicalSample};
 
+use super::icm42688p::{self, Icm42688p};
 use super::mpu6xxx::{self, Mpu6xxx, Variant};
 use super::{I2cTarget, RegisterWrite, SpiTarget};
 
@@ -75,6 +76,8 @@ pub trait Chip: SpiTarget + I2cTarget {
 pub enum EmulatedChip {
     /// The InvenSense 6xxx family (MPU-9250 with its AK8963, MPU-6500, MPU-6000, ICM-20602).
     Mpu6xxx(Mpu6xxx),
+    /// The TDK InvenSense ICM-42688-P.
+    Icm42688p(Icm42688p),
 }
 
 impl Default for EmulatedChip {
@@ -93,6 +96,12 @@ impl EmulatedChip {
             return None;
         }
         let ad0 = model.i2c_addresses().get(1) == Some(&i2c_address);
+        if model == ChipModel::Icm42688p {
+            return Some(Self::Icm42688p(Icm42688p::with_config(icm42688p::Config {
+                ad0,
+                who_am_i,
+            })));
+        }
         let variant = Variant::for_model(model, who_am_i)?;
         Some(Self::Mpu6xxx(Mpu6xxx::with_config(mpu6xxx::Config {
             variant,
@@ -103,9 +112,9 @@ impl EmulatedChip {
 
     /// The models this firmware emulates.
     pub fn models() -> impl Iterator<Item = ChipModel> {
-        ChipModel::ALL
-            .into_iter()
-            .filter(|m| Variant::for_model(*m, m.who_am_i()).is_some())
+        ChipModel::ALL.into_iter().filter(|m| {
+            *m == ChipModel::Icm42688p || Variant::for_model(*m, m.who_am_i()).is_some()
+        })
     }
 }
 
@@ -114,6 +123,7 @@ macro_rules! each_chip {
     ($self:expr, $chip:ident => $call:expr) => {
         match $self {
             EmulatedChip::Mpu6xxx($chip) => $call,
+            EmulatedChip::Icm42688p($chip) => $call,
         }
     };
 }

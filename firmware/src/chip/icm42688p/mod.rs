@@ -47,6 +47,7 @@
 //! assert_eq!(spi(&mut chip, &[0x80 | 0x23, 0x00, 0x00])[1..], [0x08, 0x00]); // ACCEL_DATA_Z: 2048
 //! ```
 
+mod boundary;
 mod fifo;
 mod i2c;
 mod interrupts;
