@@ -104,14 +104,15 @@ impl ChipSetup {
         }
     }
 
-    /// The Configure of this chip at `rate` (the overrides set its full scales).
+    /// The Configure of this chip at `rate` (the overrides set its full scales and, where the
+    /// chip keeps them in one register, its output rate).
     pub fn configure(&self, rate: Rate) -> Configure {
         let mut cfg = Configure {
             who_am_i: self.who_am_i,
             i2c_address: self.i2c_address,
             ..Configure::new(self.model, rate)
         };
-        for (file, register, value) in self.settings.full_scale_writes() {
+        for (file, register, value) in self.settings.config_writes(rate.as_hz_f64()) {
             // At most two writes: always within MAX_OVERRIDES.
             let _ = cfg.overrides.push(RegisterOverride {
                 file,

@@ -3,12 +3,6 @@
 
 use crate::link::Buses;
 
-// MERGE: from regmap::icm42688p once it lands.
-const ICM42688P_IMAGE_LEN: usize = 32;
-const ICM42688P_ODRS_HZ: [f64; 12] = [
-    32_000.0, 16_000.0, 8_000.0, 4_000.0, 2_000.0, 1_000.0, 500.0, 200.0, 100.0, 50.0, 25.0, 12.5,
-];
-
 /// The register-map family a model belongs to: one chip module each.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Family {
@@ -187,7 +181,7 @@ impl ChipModel {
             Self::Mpu6500 | Self::Mpu6000 | Self::Icm20602 => {
                 crate::regmap::mpu6xxx::image::SENSORS_LEN
             }
-            Self::Icm42688p => ICM42688P_IMAGE_LEN,
+            Self::Icm42688p => crate::regmap::icm42688p::image::IMAGE_LEN,
         }
     }
 
@@ -204,7 +198,9 @@ impl ChipModel {
             Self::Mpu9250 | Self::Mpu6500 | Self::Icm20602 => {
                 close(32_000.0) || close(8_000.0) || divided(1_000.0)
             }
-            Self::Icm42688p => ICM42688P_ODRS_HZ.iter().any(|&r| close(r)),
+            Self::Icm42688p => (0..16u8)
+                .filter_map(crate::regmap::icm42688p::Odr::from_gyro_config0)
+                .any(|odr| close(1e9 / odr.period_ns() as f64)),
         }
     }
 }

@@ -2,14 +2,18 @@
 //! physical sample ↔ register image, dispatched to the chip's module.
 
 use super::{ChipModel, Family, Image, PhysicalSample};
+use crate::regmap::icm42688p::image::{ImageConfig as IcmConfig, ImageRepr as IcmRepr};
+use crate::regmap::icm42688p::{self as icm, convert as icm_convert};
 use crate::regmap::mpu6xxx::image::{ImageConfig as Mpu6xxxConfig, ImageRepr as Mpu6xxxRepr};
-use crate::regmap::mpu6xxx::{AccelFs, GyroFs};
+use crate::regmap::mpu6xxx::{self as mpu, AccelFs, GyroFs};
 
 /// The conversion settings of one chip family (full scales, offsets, magnetometer settings).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Conversion {
     /// InvenSense 6xxx (and the AK8963 of the MPU-9250).
     Mpu6xxx(Mpu6xxxConfig),
+    /// ICM-42688-P (full scales; the 20-bit FIFO values have fixed ones).
+    Icm42688p(IcmConfig),
 }
 
 /// A full-scale choice: accelerometer range in g, gyroscope range in °/s.
@@ -57,10 +61,11 @@ impl ChipSettings {
     /// fuse-ROM sensitivity adjustment, so a driver that applies it reads the true field).
     pub fn power_on(model: ChipModel) -> Self {
         let conversion = match model.family() {
-            Family::Mpu6xxx | Family::Icm42688p => Conversion::Mpu6xxx(Mpu6xxxConfig {
+            Family::Mpu6xxx => Conversion::Mpu6xxx(Mpu6xxxConfig {
                 asa: crate::regmap::ak8963::EMULATED_ASA,
                 ..Mpu6xxxConfig::NOMINAL
             }),
+            Family::Icm42688p => Conversion::Icm42688p(IcmConfig::NOMINAL),
         };
         Self { model, conversion }
     }
@@ -80,20 +85,50 @@ impl ChipSettings {
                     .find(|g| f64::from(g.range_dps()) == fs.gyro_dps)
                     .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
             }
+            Conversion::Icm42688p(cfg) => {
+                cfg.accel_fs = icm::AccelFs::ALL
+                    .into_iter()
+                    .find(|a| icm_accel_range(*a) == fs.accel_g)
+                    .ok_or(SettingsError::AccelRange(fs.accel_g))?;
+                cfg.gyro_fs = icm::GyroFs::ALL
+                    .into_iter()
+                    .find(|g| icm_gyro_range(*g) == fs.gyro_dps)
+                    .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
+            }
         }
         Ok(settings)
     }
 
     /// The accelerometer ranges (± g) of the model, smallest first.
     pub fn accel_ranges_g(model: ChipModel) -> impl Iterator<Item = f64> {
-        let _ = model;
-        AccelFs::ALL.into_iter().map(|a| f64::from(a.range_g()))
+        let mut ranges: heapless::Vec<f64, 8> = match model.family() {
+            Family::Mpu6xxx => AccelFs::ALL
+                .iter()
+                .map(|a| f64::from(a.range_g()))
+                .collect(),
+            Family::Icm42688p => icm::AccelFs::ALL
+                .iter()
+                .map(|a| icm_accel_range(*a))
+                .collect(),
+        };
+        ranges.sort_unstable_by(f64::total_cmp);
+        ranges.into_iter()
     }
 
     /// The gyroscope ranges (± °/s) of the model, smallest first.
     pub fn gyro_ranges_dps(model: ChipModel) -> impl Iterator<Item = f64> {
-        let _ = model;
-        GyroFs::ALL.into_iter().map(|g| f64::from(g.range_dps()))
+        let mut ranges: heapless::Vec<f64, 8> = match model.family() {
+            Family::Mpu6xxx => GyroFs::ALL
+                .iter()
+                .map(|g| f64::from(g.range_dps()))
+                .collect(),
+            Family::Icm42688p => icm::GyroFs::ALL
+                .iter()
+                .map(|g| icm_gyro_range(*g))
+                .collect(),
+        };
+        ranges.sort_unstable_by(f64::total_cmp);
+        ranges.into_iter()
     }
 
     /// The full scale in force.
@@ -103,38 +138,61 @@ impl ChipSettings {
                 accel_g: f64::from(cfg.accel_fs.range_g()),
                 gyro_dps: f64::from(cfg.gyro_fs.range_dps()),
             },
+            Conversion::Icm42688p(cfg) => FullScale {
+                accel_g: icm_accel_range(cfg.accel_fs),
+                gyro_dps: icm_gyro_range(cfg.gyro_fs),
+            },
         }
     }
 
     /// The register writes, as `(register file, register, value)`, that take a power-on chip to
-    /// these full scales (the rest of the settings are the power-on ones or the chip's own).
-    pub fn full_scale_writes(&self) -> impl Iterator<Item = (u8, u8, u8)> {
-        use crate::regmap::mpu6xxx::reg;
+    /// these full scales and, where one register holds both, to the output rate `rate_hz` (the
+    /// ICM-42688-P's GYRO_CONFIG0/ACCEL_CONFIG0; the 6xxx parts keep their power-on rate
+    /// registers). Writes that would store the power-on value are left out.
+    pub fn config_writes(&self, rate_hz: f64) -> impl Iterator<Item = (u8, u8, u8)> {
         let writes = match &self.conversion {
             Conversion::Mpu6xxx(cfg) => [
-                (0, reg::GYRO_CONFIG, cfg.gyro_fs.bits() << 3),
-                (0, reg::ACCEL_CONFIG, cfg.accel_fs.bits() << 3),
+                (0, mpu::reg::GYRO_CONFIG, cfg.gyro_fs.bits() << 3),
+                (0, mpu::reg::ACCEL_CONFIG, cfg.accel_fs.bits() << 3),
             ],
+            Conversion::Icm42688p(cfg) => {
+                let reset = |reg| icm::reset_value(0, reg);
+                let odr = (0..16u8)
+                    .filter_map(icm::Odr::from_gyro_config0)
+                    .find(|odr| (1e9 / odr.period_ns() as f64 - rate_hz).abs() <= 1e-9 * rate_hz)
+                    .map_or(reset(icm::bank0::GYRO_CONFIG0) & 0x0F, icm::Odr::bits);
+                [
+                    (0, icm::bank0::GYRO_CONFIG0, cfg.gyro_fs.bits() << 5 | odr),
+                    (0, icm::bank0::ACCEL_CONFIG0, cfg.accel_fs.bits() << 5 | odr),
+                ]
+            }
         };
-        writes.into_iter().filter(|&(_, _, value)| value != 0)
+        let model = self.model;
+        writes
+            .into_iter()
+            .filter(move |&(file, reg, value)| value != power_on_value(model, file, reg))
     }
 
-    /// The register image of `sample` (chip axes) under these settings, of the model's length.
+    /// The register image of `sample` (chip axes) under these settings, of the model's length
+    /// (the first bytes of the family's image; zero-padded should a model and a conversion of
+    /// different families ever be paired).
     pub fn image(&self, sample: &PhysicalSample) -> Image {
         let mut image = Image::zeroed(self.model.image_len()).unwrap_or_default();
-        match &self.conversion {
-            Conversion::Mpu6xxx(cfg) => {
-                let repr = Mpu6xxxRepr::from_physical(
-                    sample.acc,
-                    sample.gyr,
-                    sample.temp_c,
-                    sample.mag,
-                    cfg,
-                )
-                .emit();
-                let n = image.len();
-                image.as_mut_bytes().copy_from_slice(&repr[..n]);
+        let (acc, gyr, temp) = (sample.acc, sample.gyr, sample.temp_c);
+        let copy = |out: &mut Image, bytes: &[u8]| {
+            for (slot, b) in out.as_mut_bytes().iter_mut().zip(bytes) {
+                *slot = *b;
             }
+        };
+        match &self.conversion {
+            Conversion::Mpu6xxx(cfg) => copy(
+                &mut image,
+                &Mpu6xxxRepr::from_physical(acc, gyr, temp, sample.mag, cfg).emit(),
+            ),
+            Conversion::Icm42688p(cfg) => copy(
+                &mut image,
+                &IcmRepr::from_physical(acc, gyr, temp, cfg).emit(),
+            ),
         }
         image
     }
@@ -155,6 +213,39 @@ impl ChipSettings {
                     mag_ut: self.model.has_magnetometer().then_some(p.mag_ut),
                 }
             }
+            Conversion::Icm42688p(cfg) => {
+                let bytes: &[u8; icm::image::IMAGE_LEN] = image.try_into().ok()?;
+                let r = IcmRepr::parse(bytes);
+                Reading {
+                    acc: r
+                        .accel
+                        .map(|v| f64::from(icm_convert::accel_from_raw(v, cfg.accel_fs))),
+                    gyr: r
+                        .gyro
+                        .map(|v| f64::from(icm_convert::gyro_from_raw(v, cfg.gyro_fs))),
+                    temp_c: f64::from(icm_convert::temp_from_raw(r.temp)),
+                    mag_ut: None,
+                }
+            }
         })
     }
+}
+
+/// The register's value right after power-on (file 0 only; others count as 0).
+fn power_on_value(model: ChipModel, file: u8, reg: u8) -> u8 {
+    match (model.family(), file) {
+        (Family::Mpu6xxx, 0) => mpu::reset_value(reg),
+        (Family::Icm42688p, bank) => icm::reset_value(bank, reg),
+        _ => 0,
+    }
+}
+
+/// ± g of an ICM-42688-P accelerometer full scale.
+fn icm_accel_range(fs: icm::AccelFs) -> f64 {
+    32768.0 / f64::from(fs.lsb_per_g())
+}
+
+/// ± °/s of an ICM-42688-P gyroscope full scale (2000 · 2^−FS_SEL: 15.625 at the finest).
+fn icm_gyro_range(fs: icm::GyroFs) -> f64 {
+    2000.0 / f64::from(1u16 << fs.bits())
 }
