@@ -14,7 +14,8 @@
 //! **Refusals.** Each is answered with an Error frame and counted in `rejected_messages`:
 //! a Hello of another protocol version (1), a device → host or unknown kind (2, detail the kind
 //! byte), a payload that does not parse or images of another length than the chip's (3), a chip
-//! model, identity, image length or I2C address this device cannot emulate (4), a perturbation or a batch
+//! model (also a chip code this version does not know, detail the code), identity, image length
+//! or I2C address this device cannot emulate (4), a perturbation or a batch
 //! of the other source (5), a model the shared `Marg` refuses or a Configure while running (6),
 //! Start or samples before Configure (7), a second Start while running (9). Samples beyond the
 //! credit limit are answered with Error 8 (detail: the first dropped index, truncated).
@@ -84,6 +85,7 @@ use margemu_protocol::link::{
 use margemu_protocol::PROTOCOL_VERSION;
 
 use crate::chip::{self, Chip, EmulatedChip};
+use margemu_protocol::chip::ChipModel;
 use setup::Model;
 
 /// The shortest image of any model (the 6xxx parts without magnetometer).
@@ -345,11 +347,15 @@ impl<const N: usize> Core<N> {
             Ok(m) => m,
             Err(e) => {
                 self.counters.rx.record_error(e);
-                let code = match Kind::from_u8(kind) {
-                    None => ErrorCode::UnknownMessage,
-                    Some(_) => ErrorCode::MalformedMessage,
+                let unknown_chip = frame.payload().first().filter(|&&c| {
+                    kind == Kind::Configure as u8 && ChipModel::from_code(c).is_none()
+                });
+                let (code, detail) = match (Kind::from_u8(kind), unknown_chip) {
+                    (None, _) => (ErrorCode::UnknownMessage, kind),
+                    (Some(_), Some(&chip)) => (ErrorCode::UnsupportedChip, chip),
+                    (Some(_), None) => (ErrorCode::MalformedMessage, kind),
                 };
-                self.error(code, seq, u32::from(kind));
+                self.error(code, seq, u32::from(detail));
                 return;
             }
         };

@@ -49,6 +49,20 @@ impl Host {
         dev.feed(&bytes, now_ns);
     }
 
+    /// Sends `m` with its payload changed by `patch` (the CRC recomputed): a well-framed
+    /// message whose content this version may not parse.
+    pub fn send_patched(&mut self, dev: &mut Dev, m: &Message<'_>, patch: impl FnOnce(&mut [u8])) {
+        use margemu_protocol::link::{emit_frame, stuff, Frame, MAX_FRAME_LEN};
+        let mut frame = [0u8; MAX_FRAME_LEN];
+        let n = emit_frame(0, m, &mut frame).unwrap();
+        let mut f = Frame::new_unchecked(&mut frame[..n]);
+        patch(f.payload_mut());
+        f.fill_crc();
+        let mut wire = [0u8; MAX_WIRE_LEN];
+        let w = stuff(&frame[..n], &mut wire).unwrap();
+        dev.feed(&wire[..w], 0);
+    }
+
     pub fn hello(&mut self, dev: &mut Dev, session: u32) {
         let hello = margemu_protocol::link::Hello {
             protocol_version: PROTOCOL_VERSION,

@@ -105,6 +105,7 @@ pub(super) fn metadata(
                 gyro_offset: i.gyro_offset,
                 accel_offset: i.accel_offset,
             }),
+            Conversion::Icm42688p(_) => None,
         },
         scene_text: &scene.text,
     };
