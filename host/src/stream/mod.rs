@@ -32,8 +32,6 @@
 //! timeout waiting for HelloAck or credit, or the stop flag (Ctrl-C); in every case the logs
 //! ([`log`], written by their own thread) are flushed and end with an `end` row in
 //! `events.csv`.
-//!
-//! [`ImageRepr::from_physical`]: margemu_protocol::regmap::mpu6xxx::image::ImageRepr::from_physical
 
 mod flow;
 pub mod images;
