@@ -8,6 +8,17 @@
 //! 2. if the MPU's clock runs (not SLEEP, CLKSEL ≠ 7): the new accel/temp/gyro bytes, the slave
 //!    reads into EXT_SENS_DATA, the FIFO record, INT_STATUS.RAW_DATA_RDY_INT (set whether or not
 //!    it is enabled, so polling drivers see it; the pin follows INT_ENABLE), and the swap.
+//!
+//! **Accelerometer rate** (physical samples): the gyro and temperature take every latch; the
+//! accelerometer takes a new value only at its own internal rate (4 kHz with ACCEL_FCHOICE_B,
+//! else 1 kHz; always 1 kHz on the MPU-6000), decided by `regmap::mpu6xxx::rates::AccelClock` on
+//! the latch instants. Between its samples the accel registers and the FIFO repeat the last
+//! accel bytes, as the RM tables in `rates` describe. A register image (source mode (a)) is
+//! served verbatim: whoever computed it (the host) decides its accel bytes.
+//!
+//! **Temperature** is converted with the part's own scale (`Variant::temp_to_raw`: 333.87 LSB/°C
+//! from 21 °C on the MPU-9250/6500, 340 from 36.53 °C on the MPU-6000, 326.8 from 25 °C on the
+//! ICM-20602).
 
 use margemu_protocol::regmap::mpu6xxx::image::{field, ImageRepr, IMAGE_LEN};
 use margemu_protocol::regmap::mpu6xxx::{bits, DATA_LEN, SENSOR_LEN};
@@ -15,13 +26,18 @@ use margemu_protocol::regmap::mpu6xxx::{bits, DATA_LEN, SENSOR_LEN};
 use super::super::{MagSource, PhysicalSample};
 use super::Mpu6xxx;
 
+/// Bytes of ACCEL_XOUT_H..=ACCEL_ZOUT_L.
+const ACCEL_LEN: usize = 6;
+
 impl Mpu6xxx {
     pub(super) fn latch_physical(&mut self, sample: &PhysicalSample, now_ns: u64) {
         let cfg = self.image_config();
-        let repr = ImageRepr::from_physical(sample.acc, sample.gyr, sample.temp_c, [0.0; 3], &cfg);
+        let mut repr =
+            ImageRepr::from_physical(sample.acc, sample.gyr, sample.temp_c, [0.0; 3], &cfg);
+        repr.temp = self.config.variant.temp_to_raw(sample.temp_c);
         let mut sensors = [0u8; SENSOR_LEN];
         repr.emit_sensors(&mut sensors);
-        self.sample(&sensors, MagSource::Physical(sample.mag), now_ns);
+        self.sample(&sensors, MagSource::Physical(sample.mag), now_ns, true);
     }
 
     pub(super) fn latch_registers(&mut self, image: &[u8; IMAGE_LEN], now_ns: u64) {
@@ -33,10 +49,17 @@ impl Mpu6xxx {
             data,
             st2: image[field::ST2],
         };
-        self.sample(&sensors, source, now_ns);
+        self.sample(&sensors, source, now_ns, false);
     }
 
-    fn sample(&mut self, sensors: &[u8; SENSOR_LEN], mag: MagSource, now_ns: u64) {
+    /// One sample instant; `accel_rate` applies the accelerometer's own rate (physical samples).
+    fn sample(
+        &mut self,
+        sensors: &[u8; SENSOR_LEN],
+        mag: MagSource,
+        now_ns: u64,
+        accel_rate: bool,
+    ) {
         self.now_ns = self.now_ns.max(now_ns);
         if let Some(ak) = &mut self.ak {
             ak.advance(self.now_ns, mag);
@@ -45,7 +68,9 @@ impl Mpu6xxx {
             return;
         }
         let mut data: [u8; DATA_LEN] = self.latest_data();
-        data[..SENSOR_LEN].copy_from_slice(sensors);
+        let accel_held = accel_rate && !self.accel_clock.take(self.accel_period_ns(), self.now_ns);
+        let first = if accel_held { ACCEL_LEN } else { 0 };
+        data[first..SENSOR_LEN].copy_from_slice(&sensors[first..]);
         self.aux_sample(&mut data[SENSOR_LEN..]);
         self.fifo_push_record(&data);
         self.raise_interrupt(bits::INT_RAW_RDY);
