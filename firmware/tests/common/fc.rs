@@ -326,7 +326,7 @@ pub fn px4_icm20602<B: Board>(board: &mut B, polls: usize) -> Result<FcRun, FcEr
 
 /// `ProcessAccel`'s check: with four or more records, accel(0) = accel(1) and accel(2) =
 /// accel(3), or accel(1) = accel(2).
-fn px4_accel_pattern_ok(fifo: &[u8], samples: usize) -> bool {
+pub fn px4_accel_pattern_ok(fifo: &[u8], samples: usize) -> bool {
     if samples < 4 {
         return true;
     }
