@@ -26,7 +26,9 @@
 //!   DEC2_CFG (low-power averaging) and 7:6 FIFO_SIZE are stored. FIFO 1008 bytes usable (PX4's
 //!   `InvenSense_ICM20602_registers.hpp` reads it as 1008: 72 records of 14 bytes).
 //!   FIFO_EN has only GYRO_FIFO_EN (bit 4) and ACCEL_FIFO_EN (bit 3); either one brings
-//!   TEMP_OUT along, so a record with both is the 14 bytes of 0x3B..=0x48. Temperature
+//!   TEMP_OUT along (Linux's `iio/imu/inv_mpu6050` counts two temperature bytes per ICM-20602
+//!   FIFO sample whatever is enabled), so a record with both is the 14 bytes of 0x3B..=0x48
+//!   (PX4's layout). Temperature
 //!   `TEMP_OUT / 326.8 + 25` °C.
 //!
 //! A register a part lacks reads 0x00 and ignores writes ("reserved" in its map).
