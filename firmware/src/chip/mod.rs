@@ -17,8 +17,9 @@
 //! acknowledge its address ignores the following bytes until the next START.
 //!
 //! Chips:
-//! - [`Mpu6xxx`]: the InvenSense 6xxx family (the MPU-9250 and its WHO_AM_I variants) with the [`Ak8963`]
-//!   magnetometer behind its auxiliary I2C master or in bypass mode;
+//! - [`Mpu6xxx`]: the InvenSense 6xxx family ([`Variant`]: the MPU-9250 and its WHO_AM_I
+//!   variants with the [`Ak8963`] magnetometer behind the auxiliary I2C master or in bypass
+//!   mode, the MPU-6500, the MPU-6000 and the ICM-20602);
 //! - [`Ak8963`] on its own, as an [`I2cTarget`].
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.

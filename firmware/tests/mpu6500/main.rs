@@ -10,6 +10,7 @@ mod common;
 
 mod accel_rate;
 mod registers;
+mod robustness;
 
 use common::*;
 use margemu_firmware::chip::{Mpu6xxx, Variant};

@@ -97,7 +97,8 @@ pub struct Config {
 }
 
 impl Default for Config {
-    /// An MPU-9250 at 0x68 with plausible factory values (ASA near 0xB0 like real parts).
+    /// An MPU-9250 at 0x68 with plausible factory values (ASA near 0xB0 like real parts); other
+    /// parts: `Config { variant, ..Config::default() }` (ASA and INFO unused without AK8963).
     fn default() -> Self {
         Self {
             variant: Variant::Mpu9250,
