@@ -71,6 +71,7 @@ fn extra_registers_are_read_write() {
     spi_write(&mut c, 0x60, &[0x03, 0xF0]); // FIFO_WM_TH1/2
     spi_write(&mut c, 0x50, &[0xAA]); // SELF_TEST_X_GYRO
     spi_write(&mut c, 0x1D, &[0xF8]); // FIFO_SIZE, DEC2_CFG, ACCEL_FCHOICE_B
+    spi_write(&mut c, 0x11, &[0xC9]); // undocumented; ArduPilot writes and checks 0xC9
     c.latch_at(&numbered(3), MS);
     assert_eq!(spi_read(&mut c, 0x20, 3), [0x11, 0x22, 0x33]);
     assert_eq!(
@@ -80,6 +81,7 @@ fn extra_registers_are_read_write() {
     );
     assert_eq!(spi_read(&mut c, 0x50, 1), [0xAA]);
     assert_eq!(spi_read(&mut c, 0x1D, 1), [0xF8]);
+    assert_eq!(spi_read(&mut c, 0x11, 1), [0xC9]);
     assert_eq!(c.accel_period_ns(), 250_000);
 }
 

@@ -25,6 +25,7 @@
 //!   0x50–0x52, FIFO_WM_TH1/2 0x60–0x61, I2C_IF 0x70 (bit 6 I2C_IF_DIS); ACCEL_CONFIG2 bits 5:4
 //!   DEC2_CFG (low-power averaging) and 7:6 FIFO_SIZE are stored. FIFO 1008 bytes usable (PX4's
 //!   `InvenSense_ICM20602_registers.hpp` reads it as 1008: 72 records of 14 bytes).
+//!   Register 0x11 is undocumented but R/W (see [`extra_reg::ICM20602_UNDOC_0X11`]).
 //!   FIFO_EN has only GYRO_FIFO_EN (bit 4) and ACCEL_FIFO_EN (bit 3); either one brings
 //!   TEMP_OUT along (Linux's `iio/imu/inv_mpu6050` counts two temperature bytes per ICM-20602
 //!   FIFO sample whatever is enabled), so a record with both is the 14 bytes of 0x3B..=0x48
@@ -56,6 +57,10 @@ pub mod extra_reg {
     pub const MPU6000_XA_OFFS_H: u8 = 0x06;
     /// MPU-6000: PRODUCT_ID (revision), read only.
     pub const MPU6000_PRODUCT_ID: u8 = 0x0C;
+    /// ICM-20602: an undocumented R/W register; ArduPilot (and PX4's older driver) write 0xC9
+    /// to it as a checked register ("set incorrectly results in a 2.7 m/s² offset on Y"), so
+    /// it must read back what was written. Reset value 0x00 here (the part's own is unknown).
+    pub const ICM20602_UNDOC_0X11: u8 = 0x11;
     /// ICM-20602: FSYNC_INT status (read only).
     pub const ICM20602_FSYNC_INT: u8 = 0x36;
     /// ICM-20602: FIFO watermark interrupt status (read only).
@@ -172,6 +177,7 @@ impl Variant {
                     | 0x0A
                     | 0x0B
                     | 0x0D..=0x0F
+                    | extra_reg::ICM20602_UNDOC_0X11
                     | 0x13..=0x1E
                     | 0x20..=0x23
                     | 0x36..=0x48
@@ -381,6 +387,7 @@ mod tests {
         }
         assert_eq!(v.write_mask(0x70), 0xFF);
         assert_eq!(v.write_mask(0x60), 0xFF);
+        assert_eq!(v.write_mask(0x11), 0xFF);
         assert_eq!(v.write_mask(0x36), 0x00);
         assert_eq!(v.write_mask(reg::SIGNAL_PATH_RESET), 0xFC);
         assert_eq!(v.write_mask(reg::USER_CTRL), 0xFA);
