@@ -115,3 +115,32 @@ fn image_latches_are_served_verbatim() {
         assert_eq!(spi_read(&mut c, 0x3B, 2), [0x00, k]);
     }
 }
+
+#[test]
+fn the_gyro_repeats_only_when_latched_faster_than_it_samples() {
+    // DLPF_CFG 1: gyro 1 kHz. A board latching every 125 µs (faster than the output rate the
+    // chip asks for) sees each gyro value eight times; GYRO_RST restarts the gyro's clock.
+    let mut c = chip(Variant::Mpu6500);
+    spi_write(&mut c, 0x1A, &[0x01]);
+    spi_write(&mut c, 0x1B, &[0x18]);
+    assert_eq!(c.gyro_period_ns(), 1_000_000);
+    let gyro: Vec<i16> = (1..=9u64)
+        .map(|k| {
+            c.latch_at(&numbered(k), k * 125_000);
+            be(&spi_read(&mut c, 0x43, 2), 0)
+        })
+        .collect();
+    assert_eq!(gyro, [1, 1, 1, 1, 1, 1, 1, 8, 8]);
+    spi_write(&mut c, 0x68, &[0x04]); // GYRO_RST
+    c.latch_at(&numbered(10), 10 * 125_000);
+    assert_eq!(spi_read(&mut c, 0x43, 2), [0x00, 0x0A]);
+    // The ICM-20602 has no GYRO_RST: bit 2 is stored and restarts nothing.
+    let mut c = chip(Variant::Icm20602);
+    spi_write(&mut c, 0x6B, &[0x01]);
+    spi_write(&mut c, 0x1A, &[0x01]);
+    spi_write(&mut c, 0x1B, &[0x18]);
+    c.latch_at(&numbered(8), MS);
+    spi_write(&mut c, 0x68, &[0x04]);
+    c.latch_at(&numbered(9), MS + 125_000);
+    assert_eq!(spi_read(&mut c, 0x43, 2), [0x00, 0x08]);
+}

@@ -14,7 +14,8 @@
 //! **Samples.** The board calls [`Mpu6xxx::latch_at`] once per sample period
 //! ([`Mpu6xxx::sample_period_ns`], which follows SMPLRT_DIV, CONFIG and GYRO_CONFIG) with the
 //! physical sample and its instant in ns (the accelerometer takes a new value only at its own
-//! rate, [`Mpu6xxx::accel_period_ns`]; between its samples the accel bytes repeat); [`Mpu6xxx::latch`] does the same at the next instant
+//! rate, [`Mpu6xxx::accel_period_ns`]; between its samples the accel bytes repeat; the gyro
+//! likewise at [`Mpu6xxx::gyro_period_ns`], which latches at the output rate never outpace); [`Mpu6xxx::latch`] does the same at the next instant
 //! of the chip's own sample clock (its clock + one period), for callers that count samples.
 //! [`Mpu6xxx::latch_image_at`] / [`Mpu6xxx::latch_image`] take a finished
 //! [register image](margemu_protocol::regmap::mpu6xxx::image) instead (source mode (a)). A latch converts
@@ -57,7 +58,7 @@ mod spi;
 
 use margemu_protocol::regmap::ak8963::{self as ak_map, MagBits};
 use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, IMAGE_LEN};
-use margemu_protocol::regmap::mpu6xxx::rates::{self, AccelClock};
+use margemu_protocol::regmap::mpu6xxx::rates::{self, SensorClock};
 use margemu_protocol::regmap::mpu6xxx::{bits, reg, AccelFs, GyroFs, DATA_LEN};
 
 use super::ak8963::Ak8963;
@@ -124,8 +125,10 @@ pub struct Mpu6xxx {
     int_pulse_ns: Option<u64>,
     mst_status: u8,
     fifo: Fifo,
-    /// When the accelerometer last produced a new value (the accel hold rule, [`rates`]).
-    accel_clock: AccelClock,
+    /// When the accelerometer last produced a new value (the hold rule, [`rates`]).
+    accel_clock: SensorClock,
+    /// When the gyro last produced a new value.
+    gyro_clock: SensorClock,
     /// FIFO count as latched by the last FIFO_COUNTH read.
     fifo_count_latch: u16,
     aux: AuxState,
@@ -162,7 +165,8 @@ impl Mpu6xxx {
             int_pulse_ns: None,
             mst_status: 0,
             fifo: Fifo::new(config.variant.fifo_size()),
-            accel_clock: AccelClock::default(),
+            accel_clock: SensorClock::default(),
+            gyro_clock: SensorClock::default(),
             fifo_count_latch: 0,
             aux: AuxState::default(),
             ak,
@@ -237,6 +241,16 @@ impl Mpu6xxx {
         rates::accel_period_ns(
             self.config.variant,
             self.regs[usize::from(reg::ACCEL_CONFIG2)],
+        )
+    }
+
+    /// Nanoseconds between the gyro's own samples under the current CONFIG and GYRO_CONFIG
+    /// ([`rates::gyro_period_ns`]): 31 250 (32 kHz), 125 000 (8 kHz) or 1 000 000 (1 kHz).
+    pub fn gyro_period_ns(&self) -> u64 {
+        rates::gyro_period_ns(
+            self.config.variant,
+            self.regs[usize::from(reg::CONFIG)],
+            self.regs[usize::from(reg::GYRO_CONFIG)],
         )
     }
 

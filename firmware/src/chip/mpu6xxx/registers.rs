@@ -3,9 +3,10 @@
 //! reset values and missing registers come from `regmap::mpu6xxx::variant`).
 //!
 //! A register the part lacks reads 0x00 and ignores writes (they are still logged: the log is
-//! what the device under test wrote). SIGNAL_PATH_RESET's bits self-clear; ACCEL_RST (bit 1)
-//! restarts the accelerometer's sample clock, so the next latch takes a fresh accel value; the
-//! data registers keep their values (RM section 4.28: only USER_CTRL.SIG_COND_RST clears them).
+//! what the device under test wrote). SIGNAL_PATH_RESET's bits self-clear; GYRO_RST (bit 2) and
+//! ACCEL_RST (bit 1) restart that sensor's sample clock, so the next latch takes a fresh value;
+//! the data registers keep their values (RM section 4.28: only USER_CTRL.SIG_COND_RST clears
+//! them).
 //!
 //! A bus read is split in two so the SPI target can prefetch one byte ahead:
 //! [`Mpu6xxx::read_register`] returns the value (and may latch FIFO_COUNT, which is harmless if
@@ -48,6 +49,7 @@ impl Mpu6xxx {
         self.fifo_count_latch = 0;
         self.aux = Default::default();
         self.accel_clock.restart();
+        self.gyro_clock.restart();
     }
 
     /// The value a read of `addr` returns, without side effects.
@@ -112,16 +114,18 @@ impl Mpu6xxx {
         }
     }
 
-    /// SIGNAL_PATH_RESET: ACCEL_RST restarts the accelerometer's sample clock; GYRO_RST and
-    /// TEMP_RST have nothing to restart here (both sample at every latch).
+    /// SIGNAL_PATH_RESET: GYRO_RST (bit 2, where the part has it) and ACCEL_RST (bit 1)
+    /// restart that sensor's sample clock; TEMP_RST has nothing to restart (the temperature is
+    /// taken at every latch).
     fn signal_path_reset(&mut self, value: u8) {
-        let accel_rst = value
-            & 0x02
-            & self
-                .config
-                .variant
-                .self_clearing_mask(reg::SIGNAL_PATH_RESET);
-        if accel_rst != 0 {
+        let mask = self
+            .config
+            .variant
+            .self_clearing_mask(reg::SIGNAL_PATH_RESET);
+        if value & mask & 0x04 != 0 {
+            self.gyro_clock.restart();
+        }
+        if value & mask & 0x02 != 0 {
             self.accel_clock.restart();
         }
     }
@@ -149,6 +153,7 @@ impl Mpu6xxx {
                 pending[..SENSOR_LEN].fill(0);
             }
             self.accel_clock.restart();
+            self.gyro_clock.restart();
         }
         self.slv4_transfer(); // a transfer waiting for the master to be enabled
     }

@@ -9,12 +9,14 @@
 //!    reads into EXT_SENS_DATA, the FIFO record, INT_STATUS.RAW_DATA_RDY_INT (set whether or not
 //!    it is enabled, so polling drivers see it; the pin follows INT_ENABLE), and the swap.
 //!
-//! **Accelerometer rate** (physical samples): the gyro and temperature take every latch; the
-//! accelerometer takes a new value only at its own internal rate (4 kHz with ACCEL_FCHOICE_B,
-//! else 1 kHz; always 1 kHz on the MPU-6000), decided by `regmap::mpu6xxx::rates::AccelClock` on
-//! the latch instants. Between its samples the accel registers and the FIFO repeat the last
-//! accel bytes, as the RM tables in `rates` describe. A register image (source mode (a)) is
-//! served verbatim: whoever computed it (the host) decides its accel bytes.
+//! **Sensor rates** (physical samples): the accelerometer takes a new value only at its own
+//! internal rate (4 kHz with ACCEL_FCHOICE_B, else 1 kHz; always 1 kHz on the MPU-6000), the
+//! gyro at its own (32, 8 or 1 kHz), each decided by a `regmap::mpu6xxx::rates::SensorClock` on
+//! the latch instants; the temperature takes every latch. Between a sensor's samples its
+//! registers and FIFO bytes repeat the last value, as the RM tables in `rates` describe.
+//! Latched at the output rate the gyro takes every latch and the accelerometer repeats when
+//! the output rate is above its own. A register image (source mode (a)) is served verbatim:
+//! whoever computed it (the host) decides its bytes.
 //!
 //! **Temperature** is converted with the part's own scale (`Variant::temp_to_raw`: 333.87 LSB/°C
 //! from 21 °C on the MPU-9250/6500, 340 from 36.53 °C on the MPU-6000, 326.8 from 25 °C on the
@@ -26,8 +28,11 @@ use margemu_protocol::regmap::mpu6xxx::{bits, DATA_LEN, SENSOR_LEN};
 use super::super::{MagSource, PhysicalSample};
 use super::Mpu6xxx;
 
-/// Bytes of ACCEL_XOUT_H..=ACCEL_ZOUT_L.
-const ACCEL_LEN: usize = 6;
+/// ACCEL_XOUT_H..=ACCEL_ZOUT_L, TEMP_OUT_H..=TEMP_OUT_L and GYRO_XOUT_H..=GYRO_ZOUT_L within
+/// the sensor bytes.
+const ACCEL: core::ops::Range<usize> = 0..6;
+const TEMP: core::ops::Range<usize> = 6..8;
+const GYRO: core::ops::Range<usize> = 8..14;
 
 impl Mpu6xxx {
     pub(super) fn latch_physical(&mut self, sample: &PhysicalSample, now_ns: u64) {
@@ -52,13 +57,14 @@ impl Mpu6xxx {
         self.sample(&sensors, source, now_ns, false);
     }
 
-    /// One sample instant; `accel_rate` applies the accelerometer's own rate (physical samples).
+    /// One sample instant; `sensor_rates` applies the accelerometer's and the gyro's own rates
+    /// (physical samples).
     fn sample(
         &mut self,
         sensors: &[u8; SENSOR_LEN],
         mag: MagSource,
         now_ns: u64,
-        accel_rate: bool,
+        sensor_rates: bool,
     ) {
         self.now_ns = self.now_ns.max(now_ns);
         if let Some(ak) = &mut self.ak {
@@ -68,9 +74,14 @@ impl Mpu6xxx {
             return;
         }
         let mut data: [u8; DATA_LEN] = self.latest_data();
-        let accel_held = accel_rate && !self.accel_clock.take(self.accel_period_ns(), self.now_ns);
-        let first = if accel_held { ACCEL_LEN } else { 0 };
-        data[first..SENSOR_LEN].copy_from_slice(&sensors[first..]);
+        let (accel_period, gyro_period) = (self.accel_period_ns(), self.gyro_period_ns());
+        let accel_new = !sensor_rates || self.accel_clock.take(accel_period, self.now_ns);
+        let gyro_new = !sensor_rates || self.gyro_clock.take(gyro_period, self.now_ns);
+        for (new, range) in [(accel_new, ACCEL), (true, TEMP), (gyro_new, GYRO)] {
+            if new {
+                data[range.clone()].copy_from_slice(&sensors[range]);
+            }
+        }
         self.aux_sample(&mut data[SENSOR_LEN..]);
         self.fifo_push_record(&data);
         self.raise_interrupt(bits::INT_RAW_RDY);

@@ -18,22 +18,25 @@
 //! 1kHz, the same accelerometer sample may be output to the FIFO, DMP, and sensor registers more
 //! than once").
 //!
-//! **The accel hold rule** ([`AccelClock`]): the accelerometer samples at the instants
+//! **The hold rule** ([`SensorClock`]): the accelerometer samples at the instants
 //! `k · accel_period` of the chip's clock (ns since the chip's time origin). A latch at `t`
 //! takes a new accelerometer value iff an accelerometer instant fell since the latch that last
 //! took one, i.e. `t / accel_period` (integer division) differs from that latch's, or the
 //! accel period changed, or nothing was taken since a reset; otherwise the accel registers and
 //! the FIFO repeat the last value. With the gyro at 8 kHz and the accel at 4 kHz, latches at
 //! `n · 125 µs` give each accel value twice (after the first); at 8 kHz with a 1 kHz accel,
-//! eight times. Deterministic: it depends only on the latch instants and the registers.
+//! eight times. The gyro follows the same rule with its own period; latched at the output
+//! rate (never faster than the gyro's) it takes every latch, and only a board latching faster
+//! than the gyro samples sees gyro values repeat. Deterministic: it depends only on the latch
+//! instants and the registers.
 //!
 //! ```
-//! use margemu_protocol::regmap::mpu6xxx::rates::{accel_period_ns, sample_period_ns, AccelClock};
+//! use margemu_protocol::regmap::mpu6xxx::rates::{accel_period_ns, sample_period_ns, SensorClock};
 //! use margemu_protocol::regmap::mpu6xxx::variant::Variant;
 //! let v = Variant::Icm20602;
 //! assert_eq!(sample_period_ns(v, 0x07, 0x00, 0), 125_000); // DLPF_CFG 7: 8 kHz
 //! let period = accel_period_ns(v, 0x08); // ACCEL_FCHOICE_B: 4 kHz
-//! let mut clock = AccelClock::default();
+//! let mut clock = SensorClock::default();
 //! let taken: Vec<bool> = (1..=6).map(|n| clock.take(period, n * 125_000)).collect();
 //! assert_eq!(taken, [true, true, false, true, false, true]);
 //! ```
@@ -77,15 +80,16 @@ pub const fn accel_period_ns(variant: Variant, accel_config2: u8) -> u64 {
     }
 }
 
-/// The accelerometer's sample clock as the latches see it (see the module docs).
+/// A sensor's sample clock as the latches see it (see the module docs): one for the
+/// accelerometer, one for the gyro.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct AccelClock {
+pub struct SensorClock {
     /// Period and `t / period` of the latch that last took a new accel value.
     last: Option<(u64, u64)>,
 }
 
-impl AccelClock {
-    /// Whether a latch at `t_ns` takes a new accelerometer value; records it if so.
+impl SensorClock {
+    /// Whether a latch at `t_ns` takes a new value of the sensor; records it if so.
     /// `period_ns` 0 is taken as "every latch".
     pub fn take(&mut self, period_ns: u64, t_ns: u64) -> bool {
         let index = t_ns.checked_div(period_ns).unwrap_or(t_ns);
@@ -96,7 +100,7 @@ impl AccelClock {
         new
     }
 
-    /// Restarts the accelerometer path (reset): the next latch takes a new value.
+    /// Restarts the sensor's path (a reset): the next latch takes a new value.
     pub fn restart(&mut self) {
         self.last = None;
     }
@@ -135,7 +139,7 @@ mod tests {
 
     #[test]
     fn accel_clock_repeats_until_the_next_accel_instant() {
-        let mut c = AccelClock::default();
+        let mut c = SensorClock::default();
         // 8 kHz latches, 1 kHz accel: new at 125 µs (first), 1 ms, 2 ms.
         let taken = (1..=16u64).map(|n| c.take(1_000_000, n * 125_000));
         let first_new = [1, 8, 16];
