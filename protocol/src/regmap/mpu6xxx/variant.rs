@@ -16,8 +16,9 @@
 //!   note). Temperature `TEMP_OUT / 340 + 36.53` °C (RM section 4.18). PRODUCT_ID at 0x0C is not
 //!   in the RM; Betaflight's MPU-6000 driver accepts 0x14–0x18 (engineering samples) and
 //!   0x54–0x5A (revisions C4 to D10), so a part answers one of them ([`MPU6000_PRODUCT_ID`]).
-//!   The accel offset trim sits at 0x06–0x0B (InvenSense AN-XX-0XX "MPU Hardware Offset
-//!   Registers"), the self-test registers at 0x0D–0x10.
+//!   The accel offset trim sits at 0x06–0x0B (InvenSense application note "MPU Hardware
+//!   Offset Registers"; the `mpu6050-dmp` crate's calibration writes it there), the self-test
+//!   registers at 0x0D–0x10.
 //! - ICM-20602: DS-000176 rev. 1.0 sections 9–11: WHO_AM_I 0x12, reset values 0x00 except
 //!   CONFIG = 0x80, PWR_MGMT_1 = 0x41, WHO_AM_I; no auxiliary I2C master and no EXT_SENS_DATA
 //!   (0x24–0x35, 0x49–0x5F, 0x63–0x67 reserved), no DMP (0x6D–0x6F); its own registers
