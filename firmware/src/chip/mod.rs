@@ -20,8 +20,9 @@
 //! use of any chip; [`EmulatedChip`] is the chip a device runs, chosen by the host's Configure.
 //!
 //! Chips:
-//! - [`Mpu6xxx`]: the InvenSense 6xxx family (the MPU-9250 and its WHO_AM_I variants) with the [`Ak8963`]
-//!   magnetometer behind its auxiliary I2C master or in bypass mode;
+//! - [`Mpu6xxx`]: the InvenSense 6xxx family ([`Variant`]: the MPU-9250 and its WHO_AM_I
+//!   variants with the [`Ak8963`] magnetometer behind the auxiliary I2C master or in bypass
+//!   mode, the MPU-6500, the MPU-6000 and the ICM-20602);
 //! - [`Ak8963`] on its own, as an [`I2cTarget`];
 //! - [`Icm42688p`]: the TDK InvenSense ICM-42688-P (banks 0–4, 2 KB FIFO with 16- and 20-bit
 //!   packets, INT1/INT2).

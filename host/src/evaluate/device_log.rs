@@ -214,6 +214,7 @@ mod tests {
             asa: [120, 128, 140],
             gyro_offset: [0; 3],
             accel_offset: [100, -64, 0],
+            ..ImageConfig::NOMINAL
         };
         let meta = SessionMeta {
             start_host_ns: 0,

@@ -51,6 +51,7 @@ pub fn image_config() -> ImageConfig {
         asa: margemu_protocol::regmap::ak8963::EMULATED_ASA,
         gyro_offset: [0; 3],
         accel_offset: [0; 3],
+        ..ImageConfig::NOMINAL
     }
 }
 

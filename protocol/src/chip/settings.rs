@@ -63,6 +63,8 @@ impl ChipSettings {
         let conversion = match model.family() {
             Family::Mpu6xxx => Conversion::Mpu6xxx(Mpu6xxxConfig {
                 asa: crate::regmap::ak8963::EMULATED_ASA,
+                temp: mpu::variant::Variant::for_model(model, model.who_am_i())
+                    .map_or(Default::default(), |v| v.temperature()),
                 ..Mpu6xxxConfig::NOMINAL
             }),
             Family::Icm42688p => Conversion::Icm42688p(IcmConfig::NOMINAL),

@@ -1,8 +1,9 @@
 //! Register maps of the emulated chips and the one place where physical values become register
 //! values (see `docs/spec/mpu9250.md`).
 //!
-//! - [`mpu6xxx`]: the InvenSense 6xxx family (MPU-9250 and its variants): addresses, bits,
-//!   reset values, write masks, full scales, the output-rate rule, the physical → register
+//! - [`mpu6xxx`]: the InvenSense 6xxx family (MPU-9250 and its variants, MPU-6000, MPU-6500,
+//!   ICM-20602): addresses, bits, reset values, write masks, per-part differences
+//!   ([`mpu6xxx::variant`]), full scales, the output and accel rates ([`mpu6xxx::rates`]), the physical → register
 //!   conversions ([`mpu6xxx::convert`]) and the register image of one sample
 //!   ([`mpu6xxx::image`]);
 //! - [`ak8963`]: the same for the AK8963 magnetometer die behind the MPU-9250's auxiliary bus;

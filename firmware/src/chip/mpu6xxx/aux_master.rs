@@ -42,8 +42,10 @@ impl AuxState {
 }
 
 impl Mpu6xxx {
+    /// The master runs if the part has one (not the ICM-20602) and USER_CTRL.I2C_MST_EN is set.
     fn master_enabled(&self) -> bool {
-        self.regs[usize::from(reg::USER_CTRL)] & bits::USER_I2C_MST_EN != 0
+        self.config.variant.has_aux_master()
+            && self.regs[usize::from(reg::USER_CTRL)] & bits::USER_I2C_MST_EN != 0
     }
 
     /// One sample of the master: slaves 0..=3 in order, reads into `ext` (EXT_SENS_DATA).

@@ -7,7 +7,7 @@ use margemu_protocol::regmap::ak8963;
 use margemu_protocol::regmap::mpu6xxx::{bits, is_read_only, next_address, reg, write_mask};
 
 use super::super::{Chip, I2cTarget, RegisterWrite, SpiTarget};
-use super::{Mpu6xxx, Variant};
+use super::Mpu6xxx;
 
 /// Registers whose SPI write does more than store `value & write_mask` (resets, FIFO pushes,
 /// transfers, registers a read does not return as stored).
@@ -18,28 +18,6 @@ const WRITE_SIDE_EFFECTS: [u8; 5] = [
     reg::FIFO_R_W,
     reg::MEM_R_W,
 ];
-
-impl Variant {
-    /// The variant of `model` answering `who_am_i`, if this firmware emulates it.
-    pub fn for_model(model: ChipModel, who_am_i: u8) -> Option<Self> {
-        let variant = match (model, who_am_i) {
-            (ChipModel::Mpu9250, 0x71) => Self::Mpu9250,
-            (ChipModel::Mpu9250, 0x73) => Self::Mpu9255,
-            (ChipModel::Mpu9250, 0x68) => Self::WhoAmI68,
-            (ChipModel::Mpu6500, 0x70) => Self::Mpu6500,
-            _ => return None,
-        };
-        Some(variant)
-    }
-
-    /// The chip model the variant is one identity of.
-    pub fn model(self) -> ChipModel {
-        match self {
-            Self::Mpu9250 | Self::Mpu9255 | Self::WhoAmI68 => ChipModel::Mpu9250,
-            Self::Mpu6500 => ChipModel::Mpu6500,
-        }
-    }
-}
 
 fn spi_write(chip: &mut Mpu6xxx, register: u8, value: u8) {
     chip.select();

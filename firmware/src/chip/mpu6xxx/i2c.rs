@@ -1,14 +1,15 @@
 //! The I2C target (PS-MPU-9250A-01 section 7.3): address 0x68 | AD0; the first byte written
 //! after a START sets the register pointer, further bytes write and move it on; reads start at
 //! the pointer and move it on (not on FIFO_R_W or MEM_R_W), across repeated STARTs. Pointer
-//! bytes keep 7 bits. USER_CTRL.I2C_IF_DIS makes the MPU-9250 ignore its address.
+//! bytes keep 7 bits. USER_CTRL.I2C_IF_DIS (and, on the ICM-20602, I2C_IF.I2C_IF_DIS) makes the
+//! chip ignore its address until a reset.
 //!
 //! In bypass mode (INT_PIN_CFG.BYPASS_EN set, USER_CTRL.I2C_MST_EN clear) the AK8963 answers at
 //! 0x0C; its register writes are logged like the MPU-9250's. A data sample waiting for the bus
 //! appears at STOP.
 
 use margemu_protocol::regmap::ak8963::I2C_ADDRESS as AK_ADDRESS;
-use margemu_protocol::regmap::mpu6xxx::{bits, next_address, reg};
+use margemu_protocol::regmap::mpu6xxx::next_address;
 
 use super::super::{Bus, I2cTarget};
 use super::Mpu6xxx;
@@ -43,7 +44,7 @@ impl I2cState {
 impl I2cTarget for Mpu6xxx {
     fn start(&mut self, address: u8, read: bool) -> bool {
         self.i2c.active = true;
-        let if_disabled = self.regs[usize::from(reg::USER_CTRL)] & bits::USER_I2C_IF_DIS != 0;
+        let if_disabled = self.i2c_interface_disabled();
         self.i2c.addressed = if address == self.i2c_address() && !if_disabled {
             Addressed::Mpu {
                 pointer_next: !read,

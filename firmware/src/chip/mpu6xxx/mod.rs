@@ -1,4 +1,10 @@
-//! The InvenSense 6xxx family (MPU-9250 and its variants: accel + gyro + temperature) with the AK8963 magnetometer, register by register.
+//! The InvenSense 6xxx family (accel + gyro + temperature), register by register: the MPU-9250
+//! and MPU-9255 with the AK8963 magnetometer, the MPU-6500, the MPU-6000 and the ICM-20602.
+//!
+//! **Variants.** One model serves every part; [`Config::variant`] picks the part's data from
+//! `margemu_protocol::regmap::mpu6xxx::variant` (identity, PRODUCT_ID, reset values, registers it
+//! lacks — they read 0 and ignore writes — or adds, FIFO size and contents, temperature scale)
+//! and `regmap::mpu6xxx::rates` (output rate, the accelerometer's own rate).
 //!
 //! [`Mpu6xxx`] serves both bus-target traits: [`SpiTarget`](super::SpiTarget) (first byte
 //! `0x80 | address` reads, `address` writes; bursts increment the address except on FIFO_R_W and
@@ -7,7 +13,9 @@
 //!
 //! **Samples.** The board calls [`Mpu6xxx::latch_at`] once per sample period
 //! ([`Mpu6xxx::sample_period_ns`], which follows SMPLRT_DIV, CONFIG and GYRO_CONFIG) with the
-//! physical sample and its instant in ns; [`Mpu6xxx::latch`] does the same at the next instant
+//! physical sample and its instant in ns (the accelerometer takes a new value only at its own
+//! rate, [`Mpu6xxx::accel_period_ns`]; between its samples the accel bytes repeat; the gyro
+//! likewise at [`Mpu6xxx::gyro_period_ns`], which latches at the output rate never outpace); [`Mpu6xxx::latch`] does the same at the next instant
 //! of the chip's own sample clock (its clock + one period), for callers that count samples.
 //! [`Mpu6xxx::latch_image_at`] / [`Mpu6xxx::latch_image`] take a finished
 //! [register image](margemu_protocol::regmap::mpu6xxx::image) instead (source mode (a)). A latch converts
@@ -51,7 +59,8 @@ mod spi;
 
 use margemu_protocol::regmap::ak8963::{self as ak_map, MagBits};
 use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, IMAGE_LEN};
-use margemu_protocol::regmap::mpu6xxx::{bits, reg, sample_period_ns, AccelFs, GyroFs, DATA_LEN};
+use margemu_protocol::regmap::mpu6xxx::rates::{self, SensorClock};
+use margemu_protocol::regmap::mpu6xxx::{bits, reg, AccelFs, GyroFs, DATA_LEN};
 
 use super::ak8963::Ak8963;
 use super::write_log::{RegisterWrite, WriteLog};
@@ -68,41 +77,12 @@ pub const WRITE_LOG_LEN: usize = 128;
 /// Duration of the INT pulse when LATCH_INT_EN is clear (RM section 4.19).
 pub const INT_PULSE_NS: u64 = 50_000;
 
-/// Which part of the family the chip claims to be.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Variant {
-    /// MPU-9250, WHO_AM_I 0x71, with AK8963.
-    #[default]
-    Mpu9250,
-    /// MPU-9255, WHO_AM_I 0x73, with AK8963.
-    Mpu9255,
-    /// MPU-6500 (also sold as "MPU-9250" without magnetometer), WHO_AM_I 0x70, no AK8963.
-    Mpu6500,
-    /// An MPU-9250 answering WHO_AM_I 0x68 (the reset value RM rev. 1.4 prints), with AK8963.
-    WhoAmI68,
-}
-
-impl Variant {
-    /// The WHO_AM_I value.
-    pub const fn who_am_i(self) -> u8 {
-        match self {
-            Self::Mpu9250 => 0x71,
-            Self::Mpu9255 => 0x73,
-            Self::Mpu6500 => 0x70,
-            Self::WhoAmI68 => 0x68,
-        }
-    }
-
-    /// Whether the package holds an AK8963.
-    pub const fn has_magnetometer(self) -> bool {
-        !matches!(self, Self::Mpu6500)
-    }
-}
+pub use margemu_protocol::regmap::mpu6xxx::variant::Variant;
 
 /// What makes one emulated part differ from another.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Config {
-    /// WHO_AM_I and whether the AK8963 is present.
+    /// Which part: identity, reset values, registers, FIFO size, whether the AK8963 is present.
     pub variant: Variant,
     /// The AD0 pin: I2C address 0x69 when high, 0x68 when low.
     pub ad0: bool,
@@ -110,14 +90,17 @@ pub struct Config {
     pub asa: [u8; 3],
     /// AK8963 INFO register (undocumented content).
     pub ak8963_info: u8,
-    /// Factory self-test values: SELF_TEST_X/Y/Z_GYRO, SELF_TEST_X/Y/Z_ACCEL.
+    /// Factory self-test values: SELF_TEST_X/Y/Z_GYRO, SELF_TEST_X/Y/Z_ACCEL (the MPU-6000's
+    /// SELF_TEST_X/Y/Z/A take the first four; see `Variant::self_test_registers`).
     pub self_test: [u8; 6],
-    /// Factory accel offset trim: XA/YA/ZA_OFFSET_H:L register pairs.
+    /// Factory accel offset trim: XA/YA/ZA_OFFSET_H:L register pairs (0x77.. or, on the
+    /// MPU-6000, 0x06..).
     pub accel_offset: [u16; 3],
 }
 
 impl Default for Config {
-    /// An MPU-9250 at 0x68 with plausible factory values (ASA near 0xB0 like real parts).
+    /// An MPU-9250 at 0x68 with plausible factory values (ASA near 0xB0 like real parts); other
+    /// parts: `Config { variant, ..Config::default() }` (ASA and INFO unused without AK8963).
     fn default() -> Self {
         Self {
             variant: Variant::Mpu9250,
@@ -130,7 +113,7 @@ impl Default for Config {
     }
 }
 
-/// The emulated MPU-9250 (see the [module docs](self)).
+/// The emulated 6xxx-family chip (see the [module docs](self)).
 #[derive(Clone, Debug)]
 pub struct Mpu6xxx {
     config: Config,
@@ -143,6 +126,10 @@ pub struct Mpu6xxx {
     int_pulse_ns: Option<u64>,
     mst_status: u8,
     fifo: Fifo,
+    /// When the accelerometer last produced a new value (the hold rule, [`rates`]).
+    accel_clock: SensorClock,
+    /// When the gyro last produced a new value.
+    gyro_clock: SensorClock,
     /// FIFO count as latched by the last FIFO_COUNTH read.
     fifo_count_latch: u16,
     aux: AuxState,
@@ -178,7 +165,9 @@ impl Mpu6xxx {
             int_status: 0,
             int_pulse_ns: None,
             mst_status: 0,
-            fifo: Fifo::new(),
+            fifo: Fifo::new(config.variant.fifo_size()),
+            accel_clock: SensorClock::default(),
+            gyro_clock: SensorClock::default(),
             fifo_count_latch: 0,
             aux: AuxState::default(),
             ak,
@@ -236,12 +225,33 @@ impl Mpu6xxx {
         self.now_ns
     }
 
-    /// Nanoseconds between samples under the current CONFIG, GYRO_CONFIG and SMPLRT_DIV.
+    /// Nanoseconds between samples under the current CONFIG, GYRO_CONFIG and SMPLRT_DIV
+    /// ([`rates::sample_period_ns`]).
     pub fn sample_period_ns(&self) -> u64 {
-        sample_period_ns(
+        rates::sample_period_ns(
+            self.config.variant,
             self.regs[usize::from(reg::CONFIG)],
             self.regs[usize::from(reg::GYRO_CONFIG)],
             self.regs[usize::from(reg::SMPLRT_DIV)],
+        )
+    }
+
+    /// Nanoseconds between the accelerometer's own samples under the current ACCEL_CONFIG2
+    /// ([`rates::accel_period_ns`]): 250 000 (4 kHz) or 1 000 000 (1 kHz).
+    pub fn accel_period_ns(&self) -> u64 {
+        rates::accel_period_ns(
+            self.config.variant,
+            self.regs[usize::from(reg::ACCEL_CONFIG2)],
+        )
+    }
+
+    /// Nanoseconds between the gyro's own samples under the current CONFIG and GYRO_CONFIG
+    /// ([`rates::gyro_period_ns`]): 31 250 (32 kHz), 125 000 (8 kHz) or 1 000 000 (1 kHz).
+    pub fn gyro_period_ns(&self) -> u64 {
+        rates::gyro_period_ns(
+            self.config.variant,
+            self.regs[usize::from(reg::CONFIG)],
+            self.regs[usize::from(reg::GYRO_CONFIG)],
         )
     }
 
@@ -258,6 +268,7 @@ impl Mpu6xxx {
             i16::from_be_bytes([self.regs[a], self.regs[a + 1]])
         };
         let trim = self.config.accel_offset;
+        let offset_regs = self.config.variant.accel_offset_registers();
         ImageConfig {
             accel_fs: AccelFs::from_accel_config(self.regs[usize::from(reg::ACCEL_CONFIG)]),
             gyro_fs: GyroFs::from_gyro_config(self.regs[usize::from(reg::GYRO_CONFIG)]),
@@ -265,9 +276,10 @@ impl Mpu6xxx {
             asa: self.config.asa,
             gyro_offset: [reg::XG_OFFSET_H, reg::YG_OFFSET_H, reg::ZG_OFFSET_H].map(pair),
             accel_offset: core::array::from_fn(|i| {
-                let now = pair([reg::XA_OFFSET_H, reg::YA_OFFSET_H, reg::ZA_OFFSET_H][i]);
+                let now = pair(offset_regs[i]);
                 (now & !1).wrapping_sub(trim[i] as i16 & !1)
             }),
+            temp: self.config.variant.temperature(),
         }
     }
 

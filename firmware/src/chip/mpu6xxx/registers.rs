@@ -1,14 +1,20 @@
 //! Register-file semantics shared by the SPI and I2C targets: what a read returns and changes,
-//! what a write stores and triggers (RM-MPU-9250A-00 section 4).
+//! what a write stores and triggers (RM-MPU-9250A-00 section 4; the other parts' differences,
+//! reset values and missing registers come from `regmap::mpu6xxx::variant`).
+//!
+//! A register the part lacks reads 0x00 and ignores writes (they are still logged: the log is
+//! what the device under test wrote). SIGNAL_PATH_RESET's bits self-clear; GYRO_RST (bit 2) and
+//! ACCEL_RST (bit 1) restart that sensor's sample clock, so the next latch takes a fresh value;
+//! the data registers keep their values (RM section 4.28: only USER_CTRL.SIG_COND_RST clears
+//! them).
 //!
 //! A bus read is split in two so the SPI target can prefetch one byte ahead:
 //! [`Mpu6xxx::read_register`] returns the value (and may latch FIFO_COUNT, which is harmless if
 //! the byte is never clocked out); [`Mpu6xxx::commit_read`] applies what clocking the byte out
 //! does — popping the FIFO, clearing INT_STATUS or I2C_MST_STATUS. The I2C target commits at once.
 
-use margemu_protocol::regmap::mpu6xxx::{
-    bits, is_read_only, reg, reset_value, write_mask, DATA_LEN, SENSOR_LEN,
-};
+use margemu_protocol::regmap::mpu6xxx::variant::extra_reg;
+use margemu_protocol::regmap::mpu6xxx::{bits, reg, DATA_LEN, SENSOR_LEN};
 
 use super::super::Bus;
 use super::Mpu6xxx;
@@ -21,15 +27,17 @@ impl Mpu6xxx {
     /// the part's factory trim; FIFO, interrupt and master state cleared. The AK8963 is a
     /// separate die and keeps its state.
     pub(super) fn device_reset(&mut self) {
+        let variant = self.config.variant;
         for (addr, value) in (0u8..).zip(self.regs.iter_mut()) {
-            *value = reset_value(addr);
+            *value = variant.reset_value(addr);
         }
         let trim = &self.config;
-        let self_test_regs = [0x00, 0x01, 0x02, 0x0D, 0x0E, 0x0F];
-        for (addr, value) in self_test_regs.into_iter().zip(trim.self_test) {
-            self.regs[addr] = value;
+        for (&addr, value) in variant.self_test_registers().iter().zip(trim.self_test) {
+            self.regs[usize::from(addr & 0x7F)] = value;
         }
-        for (addr, value) in [0x77usize, 0x7A, 0x7D].into_iter().zip(trim.accel_offset) {
+        let offsets = variant.accel_offset_registers();
+        for (addr, value) in offsets.into_iter().zip(trim.accel_offset) {
+            let addr = usize::from(addr.min(0x7E));
             self.regs[addr..addr + 2].copy_from_slice(&value.to_be_bytes());
         }
         self.pending = None;
@@ -40,11 +48,16 @@ impl Mpu6xxx {
         self.fifo.forget_last_read();
         self.fifo_count_latch = 0;
         self.aux = Default::default();
+        self.accel_clock.restart();
+        self.gyro_clock.restart();
     }
 
     /// The value a read of `addr` returns, without side effects.
     pub(super) fn peek_register(&self, addr: u8) -> u8 {
         let addr = addr & 0x7F;
+        if !self.config.variant.has_register(addr) {
+            return 0x00;
+        }
         match addr {
             reg::INT_STATUS => self.int_status,
             reg::I2C_MST_STATUS => self.mst_status,
@@ -87,17 +100,42 @@ impl Mpu6xxx {
         match addr {
             reg::FIFO_R_W => self.fifo_push(&[value]),
             reg::PWR_MGMT_1 if value & bits::PWR1_H_RESET != 0 => self.device_reset(),
-            _ if is_read_only(addr) => {}
+            _ if self.config.variant.is_read_only(addr) => {}
             _ => {
                 let slot = &mut self.regs[usize::from(addr)];
-                *slot = value & write_mask(addr);
+                *slot = value & self.config.variant.write_mask(addr);
                 match addr {
                     reg::USER_CTRL => self.user_ctrl_actions(value),
                     reg::I2C_SLV4_CTRL => self.slv4_transfer(),
+                    reg::SIGNAL_PATH_RESET => self.signal_path_reset(value),
                     _ => {}
                 }
             }
         }
+    }
+
+    /// SIGNAL_PATH_RESET: GYRO_RST (bit 2, where the part has it) and ACCEL_RST (bit 1)
+    /// restart that sensor's sample clock; TEMP_RST has nothing to restart (the temperature is
+    /// taken at every latch).
+    fn signal_path_reset(&mut self, value: u8) {
+        let mask = self
+            .config
+            .variant
+            .self_clearing_mask(reg::SIGNAL_PATH_RESET);
+        if value & mask & 0x04 != 0 {
+            self.gyro_clock.restart();
+        }
+        if value & mask & 0x02 != 0 {
+            self.accel_clock.restart();
+        }
+    }
+
+    /// Whether the primary I2C interface is disabled (USER_CTRL or, on the ICM-20602, I2C_IF).
+    pub(super) fn i2c_interface_disabled(&self) -> bool {
+        self.config.variant.i2c_disabled(
+            self.regs[usize::from(reg::USER_CTRL)],
+            self.regs[usize::from(extra_reg::ICM20602_I2C_IF)],
+        )
     }
 
     fn user_ctrl_actions(&mut self, value: u8) {
@@ -114,6 +152,8 @@ impl Mpu6xxx {
             if let Some(pending) = &mut self.pending {
                 pending[..SENSOR_LEN].fill(0);
             }
+            self.accel_clock.restart();
+            self.gyro_clock.restart();
         }
         self.slv4_transfer(); // a transfer waiting for the master to be enabled
     }
@@ -141,8 +181,15 @@ impl Mpu6xxx {
         if self.spi.is_active() || self.i2c.is_active() {
             return;
         }
+        // Without an auxiliary master the bytes after the sensors are other registers (the
+        // ICM-20602's FIFO_WM_TH1 at 0x60): only the sensor bytes are data there.
+        let len = if self.config.variant.has_aux_master() {
+            DATA_LEN
+        } else {
+            SENSOR_LEN
+        };
         if let Some(data) = self.pending.take() {
-            self.regs[DATA].copy_from_slice(&data);
+            self.regs[DATA][..len].copy_from_slice(&data[..len]);
         }
     }
 }

@@ -31,9 +31,10 @@
 use core::ops::Range;
 
 use super::convert::{
-    accel_to_raw_with_offset, asa_factor, gyro_to_raw_with_offset, mag_measurement, temp_to_raw,
-    STANDARD_GRAVITY, TEMP_LSB_PER_C, TEMP_OFFSET_C,
+    accel_to_raw_with_offset, asa_factor, gyro_to_raw_with_offset, mag_measurement,
+    STANDARD_GRAVITY,
 };
+use super::variant::TempScale;
 use super::{AccelFs, GyroFs};
 use crate::regmap::ak8963::{self, MagBits};
 
@@ -78,6 +79,8 @@ pub struct ImageConfig {
     pub gyro_offset: [i16; 3],
     /// How far XA/YA/ZA_OFFSET_H:L were moved from the factory trim (16-bit register units).
     pub accel_offset: [i16; 3],
+    /// The part's temperature sensor scale.
+    pub temp: TempScale,
 }
 
 impl ImageConfig {
@@ -89,6 +92,7 @@ impl ImageConfig {
         asa: [128; 3],
         gyro_offset: [0; 3],
         accel_offset: [0; 3],
+        temp: TempScale::Mpu6500,
     };
 }
 
@@ -131,7 +135,7 @@ impl ImageRepr {
             accel: core::array::from_fn(|i| {
                 accel_to_raw_with_offset(acc[i], cfg.accel_fs, cfg.accel_offset[i])
             }),
-            temp: temp_to_raw(temp_c),
+            temp: cfg.temp.to_raw(temp_c),
             gyro: core::array::from_fn(|i| {
                 gyro_to_raw_with_offset(gyr[i], cfg.gyro_fs, cfg.gyro_offset[i])
             }),
@@ -243,7 +247,7 @@ impl ImageRepr {
             gyr: core::array::from_fn(|i| {
                 (f64::from(self.gyro[i]) - gyro_offset_lsb(i)) / lsb_per_radps
             }),
-            temp_c: f64::from(self.temp) / f64::from(TEMP_LSB_PER_C) + f64::from(TEMP_OFFSET_C),
+            temp_c: cfg.temp.from_raw(self.temp),
             mag_ut: [ut(1), ut(0), -ut(2)],
         }
     }

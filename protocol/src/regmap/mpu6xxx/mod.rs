@@ -1,5 +1,9 @@
-//! The InvenSense 6xxx family (MPU-9250 and its variants), accel/gyro die: register addresses, bits, reset values, access masks, full
-//! scales and the output-rate rule (InvenSense RM-MPU-9250A-00 rev. 1.6, "RM" below).
+//! The InvenSense 6xxx family (MPU-9250, MPU-9255, MPU-6500, MPU-6000, ICM-20602), accel/gyro
+//! die: register addresses, bits, reset values, access masks, full scales and the output-rate
+//! rule. The items at this level are the MPU-9250's (InvenSense RM-MPU-9250A-00 rev. 1.6, "RM"
+//! below); [`variant`] says where each other part differs (identity, reset values, registers it
+//! lacks or adds, FIFO size and contents, temperature scale) and [`rates`] gives every part's
+//! internal gyro/accel rates, output rate and the accel hold rule.
 //!
 //! Everything here is data about the silicon; the behaviour that uses it lives in
 //! `margemu_firmware::chip`. The host uses the same tables to predict what a driver reads.
@@ -15,6 +19,8 @@
 
 pub mod convert;
 pub mod image;
+pub mod rates;
+pub mod variant;
 
 /// Register addresses (RM section 3, table 1).
 pub mod reg {

@@ -1,0 +1,206 @@
+//! Helpers shared by the 6xxx-variant test crates (`mpu6000`, `mpu6500`, `icm20602`), included
+//! with `#[path]`: byte-level bus transactions, a bench that latches numbered samples at the
+//! chip's own output rate, and the flight-controller register sequences ([`fc`]).
+//!
+//! SPI transactions are written as the bytes on MOSI and the bytes expected on MISO, aligned:
+//! `spi(&mut chip, &[0x80 | 0x75, 0x00]) == [0x00, 0x68]`.
+
+#![allow(dead_code)]
+
+pub mod fc;
+
+use margemu_firmware::chip::{Config, I2cTarget, Mpu6xxx, PhysicalSample, SpiTarget, Variant};
+
+pub const MS: u64 = 1_000_000;
+pub const G: f32 = 9.80665;
+
+/// A fresh chip of `variant` with the default factory trim.
+pub fn chip(variant: Variant) -> Mpu6xxx {
+    Mpu6xxx::with_config(Config {
+        variant,
+        ..Config::default()
+    })
+}
+
+/// One SPI transaction: MOSI bytes in, MISO bytes out, aligned byte for byte.
+pub fn spi(chip: &mut impl SpiTarget, mosi: &[u8]) -> Vec<u8> {
+    let mut miso = vec![chip.select()];
+    for (i, &byte) in mosi.iter().enumerate() {
+        let next = chip.exchange(byte);
+        if i + 1 < mosi.len() {
+            miso.push(next);
+        }
+    }
+    chip.deselect();
+    miso.truncate(mosi.len());
+    miso
+}
+
+/// Reads `n` registers from `addr` over SPI.
+pub fn spi_read(chip: &mut impl SpiTarget, addr: u8, n: usize) -> Vec<u8> {
+    let mut mosi = vec![0x80 | addr];
+    mosi.resize(n + 1, 0x00);
+    spi(chip, &mosi)[1..].to_vec()
+}
+
+/// Writes `values` from `addr` on over SPI.
+pub fn spi_write(chip: &mut impl SpiTarget, addr: u8, values: &[u8]) {
+    let mut mosi = vec![addr];
+    mosi.extend_from_slice(values);
+    assert_eq!(
+        spi(chip, &mosi),
+        vec![0; mosi.len()],
+        "MISO is 0x00 during writes"
+    );
+}
+
+/// An I2C write transaction; returns the ACK of the address and each byte.
+pub fn i2c_write(chip: &mut impl I2cTarget, address: u8, bytes: &[u8]) -> Vec<bool> {
+    let mut acks = vec![chip.start(address, false)];
+    acks.extend(bytes.iter().map(|&b| chip.write(b)));
+    chip.stop();
+    acks
+}
+
+/// Register read over I2C; `None` if the address was not acknowledged.
+pub fn i2c_read(chip: &mut impl I2cTarget, address: u8, reg: u8, n: usize) -> Option<Vec<u8>> {
+    if !chip.start(address, false) {
+        chip.stop();
+        return None;
+    }
+    chip.write(reg);
+    assert!(chip.start(address, true), "repeated START");
+    let bytes = (0..n).map(|_| chip.read()).collect();
+    chip.stop();
+    Some(bytes)
+}
+
+/// Every register as the bus would read it, without side effects.
+pub fn registers(chip: &Mpu6xxx) -> Vec<u8> {
+    (0..0x80).map(|a| chip.peek(a)).collect()
+}
+
+/// Big-endian i16 at `bytes[i..i + 2]`.
+pub fn be(bytes: &[u8], i: usize) -> i16 {
+    i16::from_be_bytes([bytes[i], bytes[i + 1]])
+}
+
+/// Sample number `k` as the chip sees it, so that at ±16 g / ±2000 °/s every register names it:
+/// ACCEL_XOUT = GYRO_XOUT = `k`, ACCEL_YOUT = GYRO_YOUT = −`k`, ACCEL_ZOUT = 2048 (1 g),
+/// GYRO_ZOUT = 7; 30 °C rising by 0.1 m°C per sample. `k` must stay below 16 384.
+pub fn numbered(k: u64) -> PhysicalSample {
+    let k = k as f32;
+    let accel_lsb = G / 2048.0;
+    let gyro_lsb = (1.0f64 / 16.4).to_radians() as f32;
+    PhysicalSample {
+        acc: [k * accel_lsb, -k * accel_lsb, G],
+        gyr: [k * gyro_lsb, -k * gyro_lsb, 7.0 * gyro_lsb],
+        mag: [0.0; 3],
+        temp_c: 30.0 + k * 1e-4,
+    }
+}
+
+/// A chip on a bench: it latches [`numbered`] samples at the instants of its own output clock
+/// (multiples of [`Mpu6xxx::sample_period_ns`], re-read after every latch and transaction) while
+/// the flight-controller code waits, and serves SPI transactions in zero time in between.
+pub struct Bench {
+    pub chip: Mpu6xxx,
+    now_ns: u64,
+    last_latch_ns: u64,
+    /// Instant of every latch, by sample number (sample `k` latched at `instants[k]`).
+    pub instants: Vec<u64>,
+    /// Whether the chip's clock ran (it took the sample) at each latch.
+    pub running: Vec<bool>,
+}
+
+impl Bench {
+    pub fn new(chip: Mpu6xxx) -> Self {
+        Self {
+            chip,
+            now_ns: 0,
+            last_latch_ns: 0,
+            instants: Vec::new(),
+            running: Vec::new(),
+        }
+    }
+
+    pub fn now_ns(&self) -> u64 {
+        self.now_ns
+    }
+
+    /// The number the next latched sample will carry.
+    pub fn next_sample(&self) -> u64 {
+        self.instants.len() as u64
+    }
+
+    fn next_instant(&self) -> u64 {
+        let period = self.chip.sample_period_ns();
+        (self.last_latch_ns / period + 1) * period
+    }
+
+    /// Lets `ns` pass, latching every sample instant in it.
+    pub fn wait_ns(&mut self, ns: u64) {
+        let end = self.now_ns + ns;
+        loop {
+            let next = self.next_instant();
+            if next > end {
+                break;
+            }
+            let k = self.next_sample();
+            self.running.push(self.chip.is_running());
+            self.chip.latch_at(&numbered(k), next);
+            self.instants.push(next);
+            self.last_latch_ns = next;
+        }
+        self.now_ns = end;
+        self.chip.advance(end);
+    }
+
+    /// Waits for the next sample instant (the data-ready edge) and returns its sample number.
+    pub fn wait_data_ready(&mut self) -> u64 {
+        let next = self.next_instant();
+        self.wait_ns(next.saturating_sub(self.now_ns));
+        self.next_sample() - 1
+    }
+
+    /// One SPI transaction, byte by byte.
+    pub fn spi(&mut self, mosi: &[u8]) -> Vec<u8> {
+        spi(&mut self.chip, mosi)
+    }
+
+    /// Reads `n` registers from `addr`.
+    pub fn read(&mut self, addr: u8, n: usize) -> Vec<u8> {
+        spi_read(&mut self.chip, addr, n)
+    }
+
+    /// Reads one register.
+    pub fn read1(&mut self, addr: u8) -> u8 {
+        self.read(addr, 1)[0]
+    }
+
+    /// Writes one register.
+    pub fn write(&mut self, addr: u8, value: u8) {
+        spi_write(&mut self.chip, addr, &[value]);
+    }
+}
+
+impl Bench {
+    /// Whether sample `k` carries a new accel value (the rule of `regmap::mpu6xxx::rates`,
+    /// restated): it is the first the chip took after sleeping, or `instant / accel_period`
+    /// differs from sample `k − 1`'s. (Valid while no reset happens between the two.)
+    pub fn new_accel(&self, k: u64, accel_period_ns: u64) -> bool {
+        let k = k as usize;
+        k == 0
+            || !self.running[k - 1]
+            || self.instants[k] / accel_period_ns != self.instants[k - 1] / accel_period_ns
+    }
+
+    /// The sample whose accel value sample `k` carries.
+    pub fn accel_source(&self, k: u64, accel_period_ns: u64) -> u64 {
+        let mut from = k;
+        while !self.new_accel(from, accel_period_ns) {
+            from -= 1;
+        }
+        from
+    }
+}
