@@ -66,6 +66,7 @@ fn configure_grants_the_whole_buffer_and_applies_overrides() {
         "overrides are not reported as writes of the device under test"
     );
     assert_eq!(dev.state(), DeviceState::Configured);
+    #[allow(irrefutable_let_patterns)] // refutable once EmulatedChip has a second family
     let EmulatedChip::Mpu6xxx(chip) = dev.chip() else {
         panic!("an MPU-9250 was configured")
     };
