@@ -32,7 +32,7 @@ pub mod mpu6xxx;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
-pub use emulated::{Chip, EmulatedChip};
+pub use emulated::{spi_read_burst_on_copy, Chip, EmulatedChip};
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 
