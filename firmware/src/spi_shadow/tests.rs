@@ -382,3 +382,31 @@ fn sim_port_overlong_and_empty_transactions() {
     let (capture, _) = transact(FAST, &mut shadow, &[]);
     assert_eq!(replay(&mut chip, &capture, 0), Outcome::Empty);
 }
+
+#[test]
+fn speculator_tells_an_empty_count_from_a_full_one() {
+    let mut s = Speculator::new();
+    let read =
+        |start: u8, data: u8| Capture::from_bytes(&[READ | start, 0, 0], &[0, 0, data], 0, None);
+    let (count, empty, data) = (
+        read(reg::FIFO_COUNTH, 14),
+        read(reg::FIFO_COUNTH, 0),
+        read(reg::FIFO_R_W, 0x5A),
+    );
+    // Polls: count then data, and now and then an empty count and nothing else.
+    let polls = [
+        &count, &data, &empty, &count, &data, &count, &data, &empty, &count, &data,
+    ];
+    let mut right = [false; 10];
+    for (r, capture) in right.iter_mut().zip(polls.iter().cycle()) {
+        let start = capture.mosi()[0] & 0x7F;
+        *r = s.predict(DEFAULT_START) == start;
+        s.observe(capture);
+    }
+    // Once each transaction has been seen before, every prediction is right: after an empty
+    // count comes the next count, after a full one the data.
+    assert_eq!(
+        right,
+        [false, false, false, false, true, true, true, true, true, true]
+    );
+}

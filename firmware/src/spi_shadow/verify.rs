@@ -132,11 +132,29 @@ pub const SUCCESSORS: usize = 16;
 /// plus one consecutive transactions that followed otherwise.
 const MAX_CONFIDENCE: u8 = 2;
 
+/// What the speculator knows of a transaction: its first MOSI byte (`R/W̄ | address`), and
+/// for a read whether every data byte the controller got was zero (drivers branch on that: an
+/// empty FIFO count, a clear status).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Key {
+    first: u8,
+    zero: bool,
+}
+
+impl Key {
+    fn of(capture: &Capture) -> Option<Self> {
+        let (&first, _) = capture.mosi().split_first()?;
+        let data = capture.sent().get(1..).unwrap_or(&[]);
+        let zero = first & 0x80 != 0 && data.iter().all(|&b| b == 0);
+        Some(Self { first, zero })
+    }
+}
+
 /// Which read followed a transaction last time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Successor {
-    /// The transaction's first MOSI byte (`R/W̄ | address`).
-    key: u8,
+    /// The transaction.
+    key: Key,
     /// The start address of the read that followed it.
     next: u8,
     /// How often in a row (saturating at [`MAX_CONFIDENCE`]) `next` was right, less the times
@@ -149,8 +167,9 @@ struct Successor {
 /// Flight-controller drivers repeat fixed transactions: a burst from one register on every
 /// data-ready, or a pair (FIFO count, then FIFO data), with writes and single-register checks
 /// in between. The speculator remembers, for each of the [`SUCCESSORS`] transactions seen
-/// last (keyed by their first MOSI byte: read or write, and address), the start address of the
-/// read that followed, with a small confidence so that one odd transaction does not unlearn a
+/// last (keyed by their first MOSI byte: read or write, and address; and for reads whether the
+/// controller got only zeros, since a driver reads FIFO data only when the count it read is not
+/// zero), the start address of the read that followed, with a small confidence so that one odd transaction does not unlearn a
 /// pattern: a remembered successor is replaced only after it was wrong
 /// [`MAX_CONFIDENCE`] + 1 times more than right. The least recently used entry makes room for a
 /// new one. Without an entry for the last transaction, the prediction falls back to where
@@ -163,8 +182,8 @@ pub struct Speculator {
     /// Most recently used first.
     table: [Successor; SUCCESSORS],
     len: usize,
-    /// The first MOSI byte of the last transaction.
-    last: Option<u8>,
+    /// The last transaction.
+    last: Option<Key>,
     fallback: Option<u8>,
     candidate: u8,
     streak: u8,
@@ -181,7 +200,10 @@ impl Speculator {
     pub const fn new() -> Self {
         Self {
             table: [Successor {
-                key: 0,
+                key: Key {
+                    first: 0,
+                    zero: false,
+                },
                 next: 0,
                 confidence: 0,
             }; SUCCESSORS],
@@ -214,14 +236,14 @@ impl Speculator {
     /// for the transaction before it, or the fallback, changed.
     pub fn observe(&mut self, capture: &Capture) -> bool {
         let mosi = capture.mosi();
-        let Some(&first) = mosi.first() else {
+        let Some(key) = Key::of(capture) else {
             return false;
         };
-        let previous = self.last.replace(first);
-        if first & 0x80 == 0 {
+        let previous = self.last.replace(key);
+        if key.first & 0x80 == 0 {
             return false;
         }
-        let start = first & 0x7F;
+        let start = key.first & 0x7F;
         let mut changed = match previous {
             Some(key) => self.learn(key, start),
             None => false,
@@ -232,12 +254,12 @@ impl Speculator {
         changed
     }
 
-    fn find(&self, key: u8) -> Option<usize> {
+    fn find(&self, key: Key) -> Option<usize> {
         self.table[..self.len].iter().position(|s| s.key == key)
     }
 
     /// `start` followed the transaction `key`; the entry moves to the front.
-    fn learn(&mut self, key: u8, start: u8) -> bool {
+    fn learn(&mut self, key: Key, start: u8) -> bool {
         let (mut entry, at, changed) = match self.find(key) {
             Some(i) => {
                 let mut e = self.table[i];
