@@ -135,18 +135,12 @@ impl Default for Shadow {
 }
 
 impl Shadow {
-    /// An all-zero shadow, bursts moving to the next address, no write applied (what a board
-    /// serves before its first [`Shadow::capture`]).
+    /// An all-zero shadow (what a board serves before its first [`Shadow::capture`]: zeros;
+    /// all zero, so a board's static shadows cost no flash).
     pub const fn new() -> Self {
-        let mut next = [0u8; 128];
-        let mut i = 0;
-        while i < 128 {
-            next[i] = ((i + 1) & 0x7F) as u8;
-            i += 1;
-        }
         Self {
             regs: [0; 128],
-            next,
+            next: [0; 128],
             rules: [WriteRule::NONE; 128],
             stream: [0; STREAM_LEN],
             start: 0,
