@@ -200,8 +200,9 @@ impl Shadow {
     }
 
     /// Applies the write transaction `mosi` (address byte, then data) to the registers whose
-    /// write only stores a value, in the registers and in the stream. Reads are ignored; other
-    /// writes (resets, FIFO pushes, bank switches, transfers, read-only registers) wait for the
+    /// write only stores a value, in the registers and in the stream, up to the first register
+    /// whose write does more. Reads are ignored; other writes (resets, FIFO pushes, bank
+    /// switches, transfers, read-only registers), and the rest of their burst, wait for the
     /// main loop's replay and fresh capture.
     pub fn write_through(&mut self, mosi: &[u8]) {
         let Some((&first, data)) = mosi.split_first() else {
@@ -215,12 +216,15 @@ impl Shadow {
         for &value in data {
             let i = usize::from(addr);
             let rule = self.rules[i];
-            if rule.plain {
-                let stored = rule.stored(value);
-                if self.regs[i] != stored {
-                    self.regs[i] = stored;
-                    changed[i / 32] |= 1 << (i % 32);
-                }
+            if !rule.plain {
+                // It may change what the next bytes write to (a bank select): the rest of the
+                // burst waits for the replay too.
+                break;
+            }
+            let stored = rule.stored(value);
+            if self.regs[i] != stored {
+                self.regs[i] = stored;
+                changed[i / 32] |= 1 << (i % 32);
             }
             addr = self.next_address(addr);
         }

@@ -410,3 +410,247 @@ fn speculator_tells_an_empty_count_from_a_full_one() {
         [false, false, false, false, true, true, true, true, true, true]
     );
 }
+
+/// A chip with two register banks, for the shadow's sake only: REG_BANK_SEL at 0x76 in both
+/// (its write is not plain), a FIFO port at bank 0's 0x30 that pops and does not increment, a
+/// read-only count at bank 0's 0x2E; everything else stores what is written.
+#[derive(Clone, Debug)]
+struct Banked {
+    regs: [[u8; 128]; 2],
+    bank: usize,
+    fifo: [u8; 64],
+    head: usize,
+    len: usize,
+    phase: Option<(bool, u8)>,
+    selected: bool,
+    now_ns: u64,
+}
+
+impl Default for Banked {
+    fn default() -> Self {
+        Self {
+            regs: [[0; 128]; 2],
+            bank: 0,
+            fifo: [0; 64],
+            head: 0,
+            len: 0,
+            phase: None,
+            selected: false,
+            now_ns: 0,
+        }
+    }
+}
+
+const BANK_SEL: u8 = 0x76;
+const FIFO_DATA: u8 = 0x30;
+const FIFO_COUNT: u8 = 0x2E;
+
+impl Banked {
+    fn push(&mut self, byte: u8) {
+        if self.len < self.fifo.len() {
+            self.fifo[(self.head + self.len) % self.fifo.len()] = byte;
+            self.len += 1;
+        }
+    }
+    fn fifo_port(&self, addr: u8) -> bool {
+        self.bank == 0 && addr == FIFO_DATA
+    }
+    fn commit_read(&mut self, addr: u8) {
+        if self.fifo_port(addr) && self.len > 0 {
+            self.head = (self.head + 1) % self.fifo.len();
+            self.len -= 1;
+        }
+    }
+    fn store(&mut self, addr: u8, value: u8) {
+        match addr {
+            BANK_SEL => self.bank = usize::from(value & 1),
+            _ if self.bank == 0 && addr == FIFO_COUNT => {}
+            _ if self.fifo_port(addr) => self.push(value),
+            _ => self.regs[self.bank][usize::from(addr)] = value,
+        }
+    }
+}
+
+impl SpiTarget for Banked {
+    fn select(&mut self) -> u8 {
+        self.selected = true;
+        self.phase = None;
+        0
+    }
+    fn exchange(&mut self, mosi: u8) -> u8 {
+        if !self.selected {
+            return 0;
+        }
+        match self.phase {
+            None => {
+                let addr = mosi & 0x7F;
+                self.phase = Some((mosi & 0x80 != 0, addr));
+                if mosi & 0x80 != 0 {
+                    self.spi_peek(addr)
+                } else {
+                    0
+                }
+            }
+            Some((true, addr)) => {
+                self.commit_read(addr);
+                let next = self.spi_next_address(addr);
+                self.phase = Some((true, next));
+                self.spi_peek(next)
+            }
+            Some((false, addr)) => {
+                self.store(addr, mosi);
+                self.phase = Some((false, self.spi_next_address(addr)));
+                0
+            }
+        }
+    }
+    fn deselect(&mut self) {
+        self.selected = false;
+    }
+}
+
+impl crate::chip::I2cTarget for Banked {
+    fn start(&mut self, _address: u8, _read: bool) -> bool {
+        false
+    }
+    fn write(&mut self, _byte: u8) -> bool {
+        false
+    }
+    fn read(&mut self) -> u8 {
+        0xFF
+    }
+    fn stop(&mut self) {}
+}
+
+impl Chip for Banked {
+    fn model(&self) -> margemu_protocol::chip::ChipModel {
+        margemu_protocol::chip::ChipModel::Mpu9250
+    }
+    fn settings(&self) -> margemu_protocol::chip::ChipSettings {
+        EmulatedChip::default().settings()
+    }
+    fn latch_image_at(&mut self, image: &[u8], now_ns: u64) {
+        for &b in image {
+            self.push(b);
+        }
+        self.now_ns = now_ns;
+    }
+    fn latch_at(&mut self, _sample: &crate::chip::PhysicalSample, now_ns: u64) {
+        self.now_ns = now_ns;
+    }
+    fn advance(&mut self, now_ns: u64) {
+        self.now_ns = now_ns;
+    }
+    fn now_ns(&self) -> u64 {
+        self.now_ns
+    }
+    fn sample_period_ns(&self) -> u64 {
+        1_000_000
+    }
+    fn int_pin_at(&self, _now_ns: u64) -> bool {
+        false
+    }
+    fn int_open_drain(&self) -> bool {
+        false
+    }
+    fn int_pulse_end_ns(&self) -> Option<u64> {
+        None
+    }
+    fn pop_write(&mut self) -> Option<crate::chip::RegisterWrite> {
+        None
+    }
+    fn writes_dropped(&self) -> u32 {
+        0
+    }
+    fn write_register(&mut self, _file: u8, register: u8, value: u8) -> bool {
+        self.store(register & 0x7F, value);
+        true
+    }
+    fn i2c_address(&self) -> u8 {
+        0x68
+    }
+    fn spi_peek(&self, addr: u8) -> u8 {
+        let addr = addr & 0x7F;
+        match addr {
+            BANK_SEL => self.bank as u8,
+            _ if self.bank == 0 && addr == FIFO_COUNT => self.len as u8,
+            _ if self.fifo_port(addr) => {
+                if self.len > 0 {
+                    self.fifo[self.head]
+                } else {
+                    0xFF
+                }
+            }
+            _ => self.regs[self.bank][usize::from(addr)],
+        }
+    }
+    fn spi_next_address(&self, addr: u8) -> u8 {
+        if self.fifo_port(addr & 0x7F) {
+            addr & 0x7F
+        } else {
+            (addr + 1) & 0x7F
+        }
+    }
+    fn spi_plain_write(&self, addr: u8, value: u8) -> Option<u8> {
+        let addr = addr & 0x7F;
+        let special =
+            addr == BANK_SEL || (self.bank == 0 && addr == FIFO_COUNT) || self.fifo_port(addr);
+        (!special).then_some(value)
+    }
+    fn burst_start(&self) -> u8 {
+        FIFO_COUNT
+    }
+    fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
+        crate::chip::spi_read_burst_on_copy(self, start, out);
+    }
+}
+
+fn xfer(target: &mut impl SpiTarget, mosi: &[u8]) -> [u8; 64] {
+    let mut miso = [0; 64];
+    sim::transfer(target, mosi, &mut miso);
+    miso
+}
+
+#[test]
+fn a_banked_chip_is_served_through_the_boundary_alone() {
+    let mut t = sim::ShadowTarget::new(Banked::default(), SLOW);
+    // Setup at the slow clock: a register in bank 1, written and read back, then bank 0.
+    xfer(&mut t, &[BANK_SEL, 1]);
+    xfer(&mut t, &[0x10, 0x42]);
+    assert_eq!(
+        xfer(&mut t, &[READ | 0x10, 0])[1],
+        0x42,
+        "bank 1, after the recapture"
+    );
+    // A write burst through the bank select: the bytes after it go to bank 0 (replayed).
+    xfer(&mut t, &[0x75, 0x11, 0, 0x33]);
+    assert_eq!(xfer(&mut t, &[READ | 0x77, 0])[1], 0x33);
+    assert_eq!(
+        xfer(&mut t, &[READ | 0x10, 0])[1],
+        0x00,
+        "bank 0's own 0x10"
+    );
+    assert_eq!(t.stats().misses, 0);
+    // The sampling loop at the fast clock: count, then that many FIFO bytes.
+    t.set_timing(FAST);
+    t.reset_stats();
+    for k in 0..500u32 {
+        let n = 4 + (k % 3) as usize;
+        let record: [u8; 6] =
+            core::array::from_fn(|i| (k as u8).wrapping_mul(7).wrapping_add(i as u8));
+        t.chip_mut()
+            .latch_image_at(&record[..n], u64::from(k) * 1_000_000);
+        let count = xfer(&mut t, &[READ | FIFO_COUNT, 0])[1];
+        assert_eq!(usize::from(count), n);
+        let mut mosi = [0u8; 7];
+        mosi[0] = READ | FIFO_DATA;
+        let got = xfer(&mut t, &mosi[..=n]);
+        if k > 0 {
+            assert_eq!(&got[1..=n], &record[..n], "sample {k}");
+        }
+    }
+    let stats = t.stats();
+    assert_eq!(t.divergences(), 0);
+    // The count is the chip's burst start; only the first FIFO read (no successor yet) misses.
+    assert_eq!((stats.reads(), stats.misses), (1000, 1), "{stats:?}");
+}
