@@ -20,8 +20,8 @@
 //! would send it ([`Chip::spi_read_burst`]: FIFO ports pop, counters latch), from the start the
 //! [`Speculator`] predicts (the successor of the last transaction's start, else the chip's
 //! [`Chip::burst_start`], where flight-controller drivers start their sensor burst). The board
-//! preloads that stream into its
-//! TX DMA while chip select is high, so the predicted burst is served by hardware at any clock.
+//! preloads that stream into its TX DMA while chip select is high, so the predicted burst is
+//! served by hardware at any clock.
 //! Its highest-priority handler, [`serve`], watches the address byte arrive: a write, or a read
 //! at the predicted address, is left to the DMA; any other read is taken over by the CPU
 //! ([`SpiPort::stop_stream`]), which serves the rest of the burst from the shadow, and whose
@@ -65,7 +65,7 @@ mod verify;
 mod tests;
 
 pub use serve::{serve, Capture, SpiPort};
-pub use verify::{replay, Outcome, Speculator, Stats, SUCCESSORS, SWITCH_AFTER};
+pub use verify::{replay, Outcome, Speculator, Stats, MAX_CONFIDENCE, SUCCESSORS, SWITCH_AFTER};
 
 use crate::chip::Chip;
 

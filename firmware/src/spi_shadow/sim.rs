@@ -91,7 +91,8 @@ impl SimPort {
 
     fn start_of(&self, i: usize) -> u64 {
         let t = self.timing;
-        t.setup + i as u64 * (t.byte + t.turnaround)
+        let per_byte = t.byte.saturating_add(t.turnaround);
+        t.setup.saturating_add((i as u64).saturating_mul(per_byte))
     }
 
     fn advance(&mut self) {
@@ -99,7 +100,9 @@ impl SimPort {
         loop {
             let i = self.started;
             // Bytes end in order; byte `received` ends before byte `received + 1` starts.
-            let end = self.start_of(self.received) + self.timing.byte;
+            let end = self
+                .start_of(self.received)
+                .saturating_add(self.timing.byte);
             if self.received < self.started && end <= self.tick {
                 if let Some(slot) = self.rx.get_mut(self.received) {
                     *slot = self.mosi[self.received];

@@ -130,7 +130,7 @@ pub const SUCCESSORS: usize = 16;
 
 /// Highest confidence of a remembered successor: a successor is replaced after this many
 /// plus one consecutive transactions that followed otherwise.
-const MAX_CONFIDENCE: u8 = 2;
+pub const MAX_CONFIDENCE: u8 = 2;
 
 /// What the speculator knows of a transaction: its first MOSI byte (`R/W̄ | address`), and
 /// for a read whether every data byte the controller got was zero (drivers branch on that: an
