@@ -14,6 +14,7 @@ const FIFO_EN: u8 = 0x23;
 const INT_PIN_CFG: u8 = 0x37;
 const INT_ENABLE: u8 = 0x38;
 const ACCEL_XOUT_H: u8 = 0x3B;
+const EXT_SENS_DATA_00: u8 = 0x49;
 const SIGNAL_PATH_RESET: u8 = 0x68;
 const USER_CTRL: u8 = 0x6A;
 const PWR_MGMT_1: u8 = 0x6B;
@@ -59,6 +60,17 @@ pub fn betaflight(rig: &mut dyn Rig, samples: usize) -> Vec<u8> {
 /// checked registers at the setup clock. The polls drift against the samples: a late poll
 /// finds 2 records, an early one none.
 pub fn ardupilot(rig: &mut dyn Rig, samples: usize) -> Vec<u8> {
+    ardupilot_with_compass(rig, samples, false)
+}
+
+/// [`ardupilot`] with the AK8963 read through the auxiliary bus: every 10 ms (10 polls) its
+/// compass driver, on the same bus thread, reads EXT_SENS_DATA_00 (7 bytes) at the fast clock
+/// between two polls. That read follows no fixed transaction.
+pub fn ardupilot_with_ak8963(rig: &mut dyn Rig, samples: usize) -> Vec<u8> {
+    ardupilot_with_compass(rig, samples, true)
+}
+
+fn ardupilot_with_compass(rig: &mut dyn Rig, samples: usize, compass: bool) -> Vec<u8> {
     rig.set_fast(false);
     let mut decoded = vec![read(rig, WHO_AM_I)];
     write(rig, PWR_MGMT_1, 0x80);
@@ -107,6 +119,9 @@ pub fn ardupilot(rig: &mut dyn Rig, samples: usize) -> Vec<u8> {
             continue; // a late poll: the next one finds 2 records
         }
         poll(rig, &mut decoded);
+        if compass && k % 10 == 5 {
+            decoded.extend(burst(rig, EXT_SENS_DATA_00, 7));
+        }
         if k % 50 == 17 {
             poll(rig, &mut decoded); // an early poll: the FIFO is empty
         }

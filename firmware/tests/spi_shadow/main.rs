@@ -19,7 +19,7 @@ mod fc_mpu;
 use margemu_firmware::chip::{Chip, EmulatedChip, PhysicalSample, SpiTarget};
 use margemu_firmware::protocol::chip::ChipModel;
 use margemu_firmware::spi_shadow::sim::{self, ShadowTarget, Timing, FAST, SLOW};
-use margemu_firmware::spi_shadow::Stats;
+use margemu_firmware::spi_shadow::{Outcome, Stats};
 
 /// Nanoseconds in a microsecond.
 pub const US: u64 = 1_000;
@@ -46,30 +46,64 @@ impl<C: Chip> Rig for C {
     fn loop_starts(&mut self) {}
 }
 
-/// The shadow path.
-pub struct Shadowed<C>(pub ShadowTarget<C>);
+/// The shadow path, counting the loop's reads at the sample clock apart: there only a
+/// predicted read can be right from its first byte.
+pub struct Shadowed<C> {
+    /// The chip behind the shadow path.
+    pub target: ShadowTarget<C>,
+    fast: bool,
+    in_loop: bool,
+    /// Reads of the loop at the sample clock.
+    pub fast_reads: u32,
+    /// Those the predicted stream served ([`Outcome::Hit`]).
+    pub fast_hits: u32,
+}
+
+impl<C: Chip> Shadowed<C> {
+    /// `chip` behind the shadow path, at the setup clock.
+    pub fn new(chip: C) -> Self {
+        Self {
+            target: ShadowTarget::new(chip, SLOW),
+            fast: false,
+            in_loop: false,
+            fast_reads: 0,
+            fast_hits: 0,
+        }
+    }
+}
 
 impl<C: Chip> SpiTarget for Shadowed<C> {
     fn select(&mut self) -> u8 {
-        self.0.select()
+        self.target.select()
     }
     fn exchange(&mut self, mosi: u8) -> u8 {
-        self.0.exchange(mosi)
+        self.target.exchange(mosi)
     }
     fn deselect(&mut self) {
-        self.0.deselect()
+        self.target.deselect();
+        let outcome = self.target.last_outcome();
+        let read = matches!(
+            outcome,
+            Some(Outcome::Hit | Outcome::Fixed | Outcome::Miss { .. } | Outcome::Stale { .. })
+        );
+        if self.fast && self.in_loop && read {
+            self.fast_reads += 1;
+            self.fast_hits += u32::from(outcome == Some(Outcome::Hit));
+        }
     }
 }
 
 impl<C: Chip> Rig for Shadowed<C> {
     fn latch(&mut self, k: u32, now_ns: u64) {
-        self.0.chip_mut().latch_at(&sample(k), now_ns);
+        self.target.chip_mut().latch_at(&sample(k), now_ns);
     }
     fn set_fast(&mut self, fast: bool) {
-        self.0.set_timing(if fast { FAST } else { SLOW });
+        self.fast = fast;
+        self.target.set_timing(if fast { FAST } else { SLOW });
     }
     fn loop_starts(&mut self) {
-        self.0.reset_stats();
+        self.in_loop = true;
+        self.target.reset_stats();
     }
 }
 
@@ -131,12 +165,14 @@ fn mpu9250() -> EmulatedChip {
 }
 
 /// Samples each sequence runs over.
-const SAMPLES: usize = 2000;
+const SAMPLES: usize = 4000;
 
 /// What one sequence measured through the shadow path.
 pub struct Measured {
     /// The outcomes of the sampling loop's transactions.
     pub stats: Stats,
+    /// Reads of the loop at the sample clock, and those served by the predicted stream.
+    pub fast: (u32, u32),
     /// Whether the driver decoded the same through the shadow path as from the chip itself
     /// (not when a read missed: a learning miss at the loop's start is enough).
     pub decoded_same: bool,
@@ -148,57 +184,83 @@ pub struct Measured {
 pub fn measure(chip: NewChip, sequence: Sequence, samples: usize) -> Measured {
     let mut direct = chip();
     let want = sequence(&mut direct, samples);
-    let mut shadowed = Shadowed(ShadowTarget::new(chip(), SLOW));
+    let mut shadowed = Shadowed::new(chip());
     let got = sequence(&mut shadowed, samples);
     Measured {
-        stats: shadowed.0.stats(),
+        stats: shadowed.target.stats(),
+        fast: (shadowed.fast_reads, shadowed.fast_hits),
         decoded_same: got == want,
-        divergences: shadowed.0.divergences(),
+        divergences: shadowed.target.divergences(),
     }
 }
 
-/// Prints one line of figures and returns the hit rate (reads with every byte right).
-pub fn report(name: &str, stats: &Stats) -> f64 {
+/// Prints one line of figures; returns the hit rate (reads of the loop served with every byte
+/// right, by the predicted stream or by a CPU takeover at the setup clock) and the predicted
+/// rate at the sample clock (reads there served by the predicted stream: a takeover is too
+/// late for their first byte).
+pub fn report(name: &str, m: &Measured) -> (f64, f64) {
+    let stats = &m.stats;
     let reads = stats.reads();
     let rate = f64::from(stats.served_right()) / f64::from(reads.max(1));
+    let (fast_reads, fast_hits) = m.fast;
+    let predicted = f64::from(fast_hits) / f64::from(fast_reads.max(1));
     println!(
-        "{name:<22} reads {reads:>5}  hit {:>5}  fixed {:>4}  miss {:>3}  stale {:>2}  \
-         truncated {:>2}  writes {:>4}  hit rate {:.2} %",
+        "{name:<18} reads {reads:>5}: hit {:>5} fixed {:>3} miss {:>3} stale {} truncated {} \
+         = {:.2} % right; at the fast clock {fast_hits}/{fast_reads} = {:.2} % predicted; \
+         decoded as from the chip: {}",
         stats.hits,
         stats.fixed,
         stats.misses,
         stats.stale,
         stats.truncated,
-        stats.writes,
-        100.0 * rate
+        100.0 * rate,
+        100.0 * predicted,
+        m.decoded_same,
     );
-    rate
+    (rate, predicted)
 }
 
 #[test]
 fn flight_controller_sequences_hit_at_least_99_percent() {
     for &(name, chip, sequence) in SEQUENCES {
         let m = measure(chip, sequence, SAMPLES);
-        let rate = report(name, &m.stats);
+        let (rate, predicted) = report(name, &m);
         assert_eq!(
             m.divergences, 0,
             "{name}: the simulation handed out other bytes"
         );
         assert!(rate >= 0.99, "{name}: hit rate {:.2} %", 100.0 * rate);
-        println!(
-            "{name:<22} decoded as from the chip itself: {}",
-            m.decoded_same
+        assert!(
+            predicted >= 0.99,
+            "{name}: predicted {:.2} %",
+            100.0 * predicted
         );
     }
+}
+
+#[test]
+fn a_read_on_a_timer_of_its_own_is_missed() {
+    // A documented limit, measured: ArduPilot's compass read between IMU polls every 10 ms
+    // follows no fixed transaction, so none is predicted (served by the stream); the CPU
+    // takeover comes after the first data byte, which is right only by chance (here it is:
+    // EXT_SENS_DATA_00 and the predicted FIFO_COUNTH are both 0x00, the aux master being off).
+    let without = measure(mpu9250, fc_mpu::ardupilot, SAMPLES);
+    let m = measure(mpu9250, fc_mpu::ardupilot_with_ak8963, SAMPLES);
+    report("ardupilot+ak8963", &m);
+    assert_eq!(m.divergences, 0);
+    let compass_reads = m.fast.0 - without.fast.0;
+    assert!(compass_reads >= 150, "{compass_reads}");
+    assert!(m.fast.1 <= without.fast.1, "no compass read predicted");
+    assert!(m.fast.1 + 10 >= without.fast.1, "the polls still are");
 }
 
 #[test]
 fn the_old_rule_alone_misses_the_count_then_data_pair() {
     // The pair alternates two starts, so no start is seen in 4 consecutive bursts: without
     // the successor table every loop read would have missed. The fallback stays unlearned.
-    let mut shadowed = Shadowed(ShadowTarget::new(mpu9250(), SLOW));
+    let mut shadowed = Shadowed::new(mpu9250());
     fc_mpu::ardupilot(&mut shadowed, 200);
-    assert_eq!(shadowed.0.speculator().fallback(), None);
+    assert_eq!(shadowed.target.speculator().fallback(), None);
 }
 
 #[test]
