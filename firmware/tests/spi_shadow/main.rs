@@ -2,17 +2,25 @@
 //!
 //! Each sequence is a driver's register traffic written from its behaviour (no code taken),
 //! as a function over a [`Rig`]: an [`SpiTarget`] that can also latch the next sample (the
-//! data-ready the driver waits for) and switch between the driver's setup and sample clocks.
-//! [`measure`] runs a sequence twice: on the chip itself (the reference) and through
-//! [`ShadowTarget`] (the board's path: shadow, `serve` on a simulated port, replay into the
-//! chip, speculation, capture), and compares what the driver decoded. The hit rate counts the
-//! reads of the sampling loop (after the driver's initialisation) whose every byte was right.
+//! data-ready the driver waits for), switch between the driver's setup and sample clocks, and
+//! mark where its sampling loop starts. [`measure`] runs a sequence twice: on the chip itself
+//! (the reference) and through [`Shadowed`] (a [`ShadowTarget`]: the board's path, shadow,
+//! `serve` on a simulated port, replay into the chip, speculation, capture). [`report`] gives
+//! the hit rate (reads of the loop with every byte right) and the predicted rate at the fast
+//! clock (reads there served by the predicted stream); both must be ≥ 99 %.
 //!
-//! **Adding a sequence.** Write `fn(&mut dyn Rig, samples: usize) -> Vec<u8>` (return what the
-//! driver decoded, in order) and add a line to [`SEQUENCES`] with a constructor for its chip.
-//! A sequence written over its own rig trait (like `tests/icm42688p/fc.rs`'s `Rig`) plugs in
-//! by implementing that trait for `ShadowTarget<C>` (SPI is there; `latch` goes to
-//! `chip_mut()`), then reading `ShadowTarget::stats()` after the run: see [`report`].
+//! **Adding a sequence.** Write `fn(&mut dyn Rig, samples: usize) -> Vec<u8>` (it returns what
+//! the driver decoded, in order; call `set_fast` around its clock changes and `loop_starts`
+//! after its initialisation) and add a line to [`SEQUENCES`]: name, chip constructor
+//! (`EmulatedChip::new(model, who_am_i, address)`), function.
+//!
+//! A sequence written over another rig trait (like `tests/icm42688p/fc.rs`'s `Rig`: SPI plus
+//! `latch`, `int1`, `image_config`) plugs in from its own test crate: implement that trait for
+//! `margemu_firmware::spi_shadow::sim::ShadowTarget<Icm42688p>` (SPI is there; `latch` is
+//! `self.chip_mut().latch_at(..)`, the others read `self.chip()`), build it with
+//! `ShadowTarget::new(chip, FAST)`, run the sequence, and compute from
+//! `ShadowTarget::stats()`: `hits / reads()` is the predicted rate at that clock (the setup
+//! reads included, unless the sequence calls `reset_stats` when its loop starts).
 
 mod fc_mpu;
 
