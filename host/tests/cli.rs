@@ -155,17 +155,32 @@ fn chips_lists_every_model_with_its_facts() {
     let out = margemu(&["chips"]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    for part in ["MPU-9250", "MPU-6500", "MPU-6000", "ICM-20602", "ICM-42688-P"] {
-        assert!(text.contains(&format!("{part} ([chip] model")), "{part}: {text}");
+    for part in [
+        "MPU-9250",
+        "MPU-6500",
+        "MPU-6000",
+        "ICM-20602",
+        "ICM-42688-P",
+    ] {
+        assert!(
+            text.contains(&format!("{part} ([chip] model")),
+            "{part}: {text}"
+        );
     }
     let out = margemu(&["chips", "icm42688p"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("WHO_AM_I:     0x47"), "{text}");
     assert!(text.contains("image:        32 bytes"), "{text}");
-    assert!(text.contains("± 15.625, 31.25, 62.5, 125, 250, 500, 1000, 2000 °/s"), "{text}");
+    assert!(
+        text.contains("± 15.625, 31.25, 62.5, 125, 250, 500, 1000, 2000 °/s"),
+        "{text}"
+    );
     assert!(text.contains("not emulated:"), "{text}");
     let out = margemu(&["chips", "bmi270"]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("no chip model \"bmi270\"; margemu emulates mpu9250"), "{err}");
+    assert!(
+        err.contains("no chip model \"bmi270\"; margemu emulates mpu9250"),
+        "{err}"
+    );
 }

@@ -68,6 +68,40 @@ pub trait Chip: SpiTarget + I2cTarget {
     fn spi_plain_write(&self, addr: u8, value: u8) -> Option<u8>;
     /// The register where drivers start their sample burst: the SPI shadow's first guess.
     fn burst_start(&self) -> u8;
+    /// Fills `out` with the data bytes an SPI read burst from `start` would return now, in
+    /// order (what MISO carries after the address byte), without its side effects on `self`.
+    ///
+    /// The default reads [`Chip::spi_peek`] along [`Chip::spi_next_address`], which is exact
+    /// only for chips whose reads change nothing a later byte of the burst returns. Chips with
+    /// FIFO ports or read-latched counters override it, usually with [`spi_read_burst_on_copy`].
+    fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
+        let mut addr = start & 0x7F;
+        for slot in out {
+            *slot = self.spi_peek(addr);
+            addr = self.spi_next_address(addr);
+        }
+    }
+    /// The 7-bit I2C addresses the chip acknowledges now, at most two (a board's I2C peripheral
+    /// owns two: the MPU-9250's own address, and the AK8963's in bypass mode). The default is
+    /// [`Chip::i2c_address`] alone.
+    fn i2c_addresses_now(&self) -> [Option<u8>; 2] {
+        [Some(self.i2c_address()), None]
+    }
+}
+
+/// [`Chip::spi_read_burst`] by running the burst on a copy of `chip` (exact whatever the
+/// chip's read side effects; costs one copy of the chip).
+pub fn spi_read_burst_on_copy<C: SpiTarget + Clone>(chip: &C, start: u8, out: &mut [u8]) {
+    let mut copy = chip.clone();
+    copy.select();
+    let mut next = copy.exchange(0x80 | start);
+    let mut slots = out.iter_mut().peekable();
+    while let Some(slot) = slots.next() {
+        *slot = next;
+        if slots.peek().is_some() {
+            next = copy.exchange(0x00);
+        }
+    }
 }
 
 /// The chip a device runs: one variant per chip family, chosen at run time by Configure.
@@ -209,5 +243,11 @@ impl Chip for EmulatedChip {
     }
     fn burst_start(&self) -> u8 {
         each_chip!(self, c => c.burst_start())
+    }
+    fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
+        each_chip!(self, c => c.spi_read_burst(start, out))
+    }
+    fn i2c_addresses_now(&self) -> [Option<u8>; 2] {
+        each_chip!(self, c => c.i2c_addresses_now())
     }
 }

@@ -36,7 +36,7 @@ pub mod mpu6xxx;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
-pub use emulated::{Chip, EmulatedChip};
+pub use emulated::{spi_read_burst_on_copy, Chip, EmulatedChip};
 pub use icm42688p::Icm42688p;
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
 pub use write_log::{Bus, RegisterWrite, WriteLog};

@@ -1,9 +1,7 @@
 //! The board's highest-priority SPI handler: [`serve`] one transaction from the [`Shadow`]
 //! through an [`SpiPort`], recording it as a [`Capture`].
 
-use margemu_protocol::regmap::mpu6xxx::next_address;
-
-use super::{burst_address, Shadow, STREAM_LEN};
+use super::{Shadow, STREAM_LEN};
 
 /// The board's SPI peripheral in target mode, as [`serve`] needs it.
 ///
@@ -155,7 +153,7 @@ fn take_over(port: &mut impl SpiPort, shadow: &Shadow, capture: &mut Capture, st
         .stream_taken()
         .saturating_sub(usize::from(waiting))
         .max(1);
-    let mut addr = burst_address(start, next);
+    let mut addr = shadow.burst_address(start, next);
     if next > 1 {
         byte = shadow.read(addr);
         port.write_tx(byte);
@@ -165,7 +163,7 @@ fn take_over(port: &mut impl SpiPort, shadow: &Shadow, capture: &mut Capture, st
     while port.selected() {
         if port.tx_empty() {
             next += 1;
-            addr = next_address(addr);
+            addr = shadow.next_address(addr);
             let byte = shadow.read(addr);
             port.write_tx(byte);
             capture.set_sent(next, byte);

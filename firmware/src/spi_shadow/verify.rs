@@ -1,9 +1,9 @@
 //! The main loop's side: [`replay`] each [`Capture`] into the chip, judge it ([`Outcome`]),
-//! count it ([`Stats`]) and learn the next burst start ([`Speculator`]).
+//! count it ([`Stats`]) and learn where the next read starts ([`Speculator`]).
 
 use crate::chip::SpiTarget;
 
-use super::{Capture, DEFAULT_START};
+use super::Capture;
 
 /// How the board served one transaction, judged against the chip's own answer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,6 +90,21 @@ pub struct Stats {
 }
 
 impl Stats {
+    /// Read transactions: [`Stats::hits`], [`Stats::fixed`], [`Stats::misses`],
+    /// [`Stats::stale`] and [`Stats::truncated`] (truncated transactions are counted as reads).
+    pub fn reads(&self) -> u32 {
+        self.hits
+            .wrapping_add(self.fixed)
+            .wrapping_add(self.misses)
+            .wrapping_add(self.stale)
+            .wrapping_add(self.truncated)
+    }
+
+    /// Reads whose every byte was right: [`Stats::hits`] and [`Stats::fixed`].
+    pub fn served_right(&self) -> u32 {
+        self.hits.wrapping_add(self.fixed)
+    }
+
     /// Counts one outcome.
     pub fn record(&mut self, outcome: Outcome) {
         let counter = match outcome {
@@ -107,16 +122,69 @@ impl Stats {
 }
 
 /// Consecutive burst reads starting at the same other register after which the
-/// [`Speculator`] moves its prediction there.
+/// [`Speculator`]'s fallback prediction moves there.
 pub const SWITCH_AFTER: u8 = 4;
 
-/// Predicts where the next burst read starts: [`DEFAULT_START`] until [`SWITCH_AFTER`]
-/// consecutive bursts (reads of two data bytes or more) start at one other register.
-/// Single-register reads (register setup, mostly at slow clocks, where the CPU takeover serves
-/// them) and writes do not move it.
+/// Transactions whose successor the [`Speculator`] remembers.
+pub const SUCCESSORS: usize = 16;
+
+/// Highest confidence of a remembered successor: a successor is replaced after this many
+/// plus one consecutive transactions that followed otherwise.
+pub const MAX_CONFIDENCE: u8 = 2;
+
+/// What the speculator knows of a transaction: its first MOSI byte (`R/W̄ | address`), and
+/// for a read whether every data byte the controller got was zero (drivers branch on that: an
+/// empty FIFO count, a clear status).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Key {
+    first: u8,
+    zero: bool,
+}
+
+impl Key {
+    fn of(capture: &Capture) -> Option<Self> {
+        let (&first, _) = capture.mosi().split_first()?;
+        let data = capture.sent().get(1..).unwrap_or(&[]);
+        let zero = first & 0x80 != 0 && data.iter().all(|&b| b == 0);
+        Some(Self { first, zero })
+    }
+}
+
+/// Which read followed a transaction last time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Successor {
+    /// The transaction.
+    key: Key,
+    /// The start address of the read that followed it.
+    next: u8,
+    /// How often in a row (saturating at [`MAX_CONFIDENCE`]) `next` was right, less the times
+    /// it was wrong since.
+    confidence: u8,
+}
+
+/// Predicts where the next read transaction starts, from the transaction before it.
+///
+/// Flight-controller drivers repeat fixed transactions: a burst from one register on every
+/// data-ready, or a pair (FIFO count, then FIFO data), with writes and single-register checks
+/// in between. The speculator remembers, for each of the [`SUCCESSORS`] transactions seen
+/// last (keyed by their first MOSI byte: read or write, and address; and for reads whether the
+/// controller got only zeros, since a driver reads FIFO data only when the count it read is not
+/// zero), the start address of the read that followed, with a small confidence so that one odd transaction does not unlearn a
+/// pattern: a remembered successor is replaced only after it was wrong
+/// [`MAX_CONFIDENCE`] + 1 times more than right. The least recently used entry makes room for a
+/// new one. Without an entry for the last transaction, the prediction falls back to where
+/// [`SWITCH_AFTER`] consecutive bursts (reads of two data bytes or more) started, else to the
+/// chip's own burst start. Empty transactions are ignored; writes are keys but never
+/// predicted (the board captures them at any clock). No allocation, fixed work per
+/// transaction, and the same transactions always give the same predictions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Speculator {
-    start: u8,
+    /// Most recently used first.
+    table: [Successor; SUCCESSORS],
+    len: usize,
+    /// The last transaction.
+    last: Option<Key>,
+    fallback: Option<u8>,
     candidate: u8,
     streak: u8,
 }
@@ -128,43 +196,115 @@ impl Default for Speculator {
 }
 
 impl Speculator {
-    /// Predicting [`DEFAULT_START`].
+    /// Nothing learned: predicting the chip's burst start.
     pub const fn new() -> Self {
         Self {
-            start: DEFAULT_START,
-            candidate: DEFAULT_START,
+            table: [Successor {
+                key: Key {
+                    first: 0,
+                    zero: false,
+                },
+                next: 0,
+                confidence: 0,
+            }; SUCCESSORS],
+            len: 0,
+            last: None,
+            fallback: None,
+            candidate: 0,
             streak: 0,
         }
     }
 
-    /// The predicted start address.
-    pub fn start(&self) -> u8 {
-        self.start
+    /// The start address of the next read: the successor of the last transaction if one is
+    /// remembered, else the burst start learned from repeated bursts, else `burst_start` (the
+    /// chip's [`Chip::burst_start`](crate::chip::Chip::burst_start)).
+    pub fn predict(&self, burst_start: u8) -> u8 {
+        self.last
+            .and_then(|key| self.find(key))
+            .map(|i| self.table[i].next)
+            .or(self.fallback)
+            .unwrap_or(burst_start)
+            & 0x7F
     }
 
-    /// Learns from one transaction; returns whether the prediction changed.
+    /// The fallback learned from repeated bursts, if any.
+    pub fn fallback(&self) -> Option<u8> {
+        self.fallback
+    }
+
+    /// Learns from one transaction (in bus order); returns whether the successor remembered
+    /// for the transaction before it, or the fallback, changed.
     pub fn observe(&mut self, capture: &Capture) -> bool {
         let mosi = capture.mosi();
-        let burst = mosi.len() >= 3;
-        let Some(&first) = mosi.first() else {
+        let Some(key) = Key::of(capture) else {
             return false;
         };
-        if first & 0x80 == 0 || !burst {
+        let previous = self.last.replace(key);
+        if key.first & 0x80 == 0 {
             return false;
         }
-        let start = first & 0x7F;
-        if start == self.start {
+        let start = key.first & 0x7F;
+        let mut changed = match previous {
+            Some(key) => self.learn(key, start),
+            None => false,
+        };
+        if mosi.len() >= 3 {
+            changed |= self.learn_fallback(start);
+        }
+        changed
+    }
+
+    fn find(&self, key: Key) -> Option<usize> {
+        self.table[..self.len].iter().position(|s| s.key == key)
+    }
+
+    /// `start` followed the transaction `key`; the entry moves to the front.
+    fn learn(&mut self, key: Key, start: u8) -> bool {
+        let (mut entry, at, changed) = match self.find(key) {
+            Some(i) => {
+                let mut e = self.table[i];
+                let changed = if e.next == start {
+                    e.confidence = (e.confidence + 1).min(MAX_CONFIDENCE);
+                    false
+                } else if e.confidence > 0 {
+                    e.confidence -= 1;
+                    false
+                } else {
+                    e.next = start;
+                    true
+                };
+                (e, i, changed)
+            }
+            None => {
+                let at = self.len.min(SUCCESSORS - 1);
+                self.len = (self.len + 1).min(SUCCESSORS);
+                let e = Successor {
+                    key,
+                    next: start,
+                    confidence: 0,
+                };
+                (e, at, true)
+            }
+        };
+        entry.next &= 0x7F;
+        self.table.copy_within(0..at, 1);
+        self.table[0] = entry;
+        changed
+    }
+
+    fn learn_fallback(&mut self, start: u8) -> bool {
+        if Some(start) == self.fallback {
             self.streak = 0;
             return false;
         }
-        if start == self.candidate {
+        if start == self.candidate && self.streak > 0 {
             self.streak = self.streak.saturating_add(1);
         } else {
             self.candidate = start;
             self.streak = 1;
         }
         if self.streak >= SWITCH_AFTER {
-            self.start = start;
+            self.fallback = Some(start);
             self.streak = 0;
             return true;
         }

@@ -1,6 +1,8 @@
-//! I2C1 as the MPU-9250's I2C target, through the PAC (the HAL has no target mode): own address
-//! 0x68 (0x69 with AD0 high), and 0x0C for the AK8963 while the chip is in bypass mode (dual
-//! addressing, OAR2), clock stretching on (RM0383, I2C chapter).
+//! I2C1 as the emulated chip's I2C target, through the PAC (the HAL has no target mode): the
+//! addresses the chip answers now ([`Chip::i2c_addresses_now`]: for the MPU-9250 its own, 0x68
+//! or 0x69 with AD0, unless its I2C interface is disabled, and 0x0C for the AK8963 in bypass
+//! mode) in OAR1 and, for a second one, OAR2 (dual addressing); clock stretching on (RM0383,
+//! I2C chapter).
 //!
 //! | pin | function (AF4, open drain) |
 //! |-----|----------------------------|
@@ -20,9 +22,7 @@
 use core::sync::atomic::{AtomicBool, Ordering};
 
 use cortex_m::peripheral::NVIC;
-use margemu_firmware::chip::{I2cTarget, Mpu6xxx};
-use margemu_firmware::protocol::regmap::ak8963;
-use margemu_firmware::protocol::regmap::mpu6xxx::{bits, reg};
+use margemu_firmware::chip::{Chip, EmulatedChip, I2cTarget};
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, I2C1};
 use stm32f4xx_hal::rcc::{Enable, Rcc, Reset};
 
@@ -69,17 +69,15 @@ pub fn init(_i2c: I2C1, rcc: &mut Rcc, pclk1_hz: u32) {
     }
 }
 
-/// Follows the chip's bus state: its address (AD0), whether the AK8963 answers (bypass), and
-/// whether the I2C interface is enabled at all (USER_CTRL.I2C_IF_DIS). Called with the device
-/// locked, so no transaction is being handled.
-pub fn configure(chip: &Mpu6xxx) {
+/// Follows the chip's bus state: the addresses it answers now, the first in OAR1 and a second
+/// one in OAR2 (dual addressing on); no address acknowledged when it answers none. Called with
+/// the device locked, so no transaction is being handled.
+pub fn configure(chip: &impl Chip) {
     let i2c = regs();
-    let oar1 = OAR1_KEEP | u16::from(chip.i2c_address()) << 1;
-    let mut oar2 = u16::from(ak8963::I2C_ADDRESS) << 1;
-    if chip.bypass_active() {
-        oar2 |= OAR2_ENDUAL;
-    }
-    let enabled = chip.peek(reg::USER_CTRL) & bits::USER_I2C_IF_DIS == 0;
+    let mut answered = chip.i2c_addresses_now().into_iter().flatten();
+    let (first, second) = (answered.next(), answered.next());
+    let oar1 = OAR1_KEEP | u16::from(first.unwrap_or_else(|| chip.i2c_address()) & 0x7F) << 1;
+    let oar2 = second.map_or(0, |a| u16::from(a & 0x7F) << 1 | OAR2_ENDUAL);
     if i2c.oar1().read().bits() != oar1 {
         i2c.oar1().write(|w| unsafe { w.bits(oar1) });
     }
@@ -87,7 +85,7 @@ pub fn configure(chip: &Mpu6xxx) {
         i2c.oar2().write(|w| unsafe { w.bits(oar2) });
     }
     let cr1 = i2c.cr1().read().bits();
-    let want = if enabled {
+    let want = if first.is_some() {
         cr1 | CR1_ACK
     } else {
         cr1 & !CR1_ACK
@@ -119,11 +117,13 @@ fn I2C1_EV() {
     if sr1.addr().bit_is_set() {
         let sr2 = i2c.sr2().read(); // SR1 then SR2 clears ADDR
         let read = sr2.tra().bit_is_set();
-        let address = if sr2.dualf().bit_is_set() {
-            ak8963::I2C_ADDRESS
+        // The address matched, as `configure` set it from the chip.
+        let own = if sr2.dualf().bit_is_set() {
+            i2c.oar2().read().bits()
         } else {
-            chip.i2c_address()
+            i2c.oar1().read().bits()
         };
+        let address = (own >> 1) as u8 & 0x7F;
         chip.start(address, read);
         let cr2 = i2c.cr2().read().bits();
         if read {
@@ -162,7 +162,7 @@ fn I2C1_ER() {
     }
 }
 
-fn end(chip: &mut Mpu6xxx) {
+fn end(chip: &mut EmulatedChip) {
     chip.stop();
     let i2c = regs();
     i2c.cr2()

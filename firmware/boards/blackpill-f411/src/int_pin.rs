@@ -1,5 +1,5 @@
-//! The MPU-9250's INT output on PB0: level and driver type follow the emulated chip
-//! (`Mpu6xxx::int_pin_at`, INT_PIN_CFG.ACTL and .OPEN), updated by the main loop after every
+//! The emulated chip's INT output on PB0: level and driver type follow the chip
+//! (`Chip::int_pin_at` and `Chip::int_open_drain`), updated by the main loop after every
 //! device access. In open-drain mode the pin only pulls low; the flight controller's input
 //! needs a pull-up (its own, or 10 kΩ to 3V3).
 

@@ -1,5 +1,6 @@
-//! margemu firmware for the WeAct STM32F411CEU6 "Black Pill": the emulated MPU-9250 (with its
-//! AK8963) on SPI1 and I2C1, its INT pin on PB0, and the host link on USB CDC.
+//! margemu firmware for the WeAct STM32F411CEU6 "Black Pill": the emulated chip (an MPU-9250
+//! with its AK8963 until the host configures another model) on SPI1 and I2C1, its INT pin on
+//! PB0, and the host link on USB CDC.
 //!
 //! Contexts, most urgent first:
 //! - EXTI4 (NSS falling, priority 0): serves each SPI transaction from a shadow of the register
@@ -8,7 +9,8 @@
 //!   while the main loop has the device ([`i2c`], [`device`]);
 //! - the main loop: USB, the link handler ([`margemu_firmware::link::Device`]) fed and polled on
 //!   the TIM5 time base ([`clock`]), the SPI transactions replayed into the chip and judged, the
-//!   shadow refreshed, the INT pin and the I2C address updated.
+//!   shadow refreshed with the speculator's prediction, the INT pin and the I2C addresses
+//!   updated.
 //!
 //! Clocks: 25 MHz HSE → SYSCLK 96 MHz (the closest to the F411's 100 MHz that gives USB its
 //! 48 MHz from the same PLL), APB1 48 MHz, APB2 96 MHz. Untested on hardware; see
@@ -28,6 +30,7 @@ use core::panic::PanicInfo;
 
 use cortex_m::peripheral::SCB;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
+use margemu_firmware::chip::Chip;
 use margemu_firmware::link::Identity;
 use margemu_firmware::protocol::link::{FirmwareVersion, ResetCause, DEVICE_ID_LEN};
 use margemu_firmware::spi_shadow::{replay, Speculator, Stats};
@@ -144,7 +147,8 @@ fn main() -> ! {
             }
             if shadow_stale {
                 if let Some(back) = spi.back() {
-                    back.capture(device.chip(), speculator.start(), generation);
+                    let chip = device.chip();
+                    back.capture(chip, speculator.predict(chip.burst_start()), generation);
                     spi.publish();
                     shadow_stale = false;
                 }

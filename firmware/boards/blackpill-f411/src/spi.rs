@@ -1,4 +1,4 @@
-//! SPI1 as the MPU-9250's SPI target (mode 3, MSB first, hardware NSS), served from a shadow
+//! SPI1 as the emulated chip's SPI target (mode 3, MSB first, hardware NSS), served from a shadow
 //! of the register file by [`margemu_firmware::spi_shadow`] (see its docs for the design, and
 //! docs/boards/blackpill-f411.md for the timing budget).
 //!

@@ -6,7 +6,7 @@ use margemu_protocol::regmap::icm42688p::{
     bank0, is_read_only, next_address, self_clearing_mask, write_mask, REG_BANK_SEL,
 };
 
-use super::super::{Chip, RegisterWrite, SpiTarget};
+use super::super::{spi_read_burst_on_copy, Chip, RegisterWrite, SpiTarget};
 use super::Icm42688p;
 
 /// Bank 0 registers whose write does more than store the masked value: resets, power-mode
@@ -106,5 +106,9 @@ impl Chip for Icm42688p {
     }
     fn burst_start(&self) -> u8 {
         bank0::TEMP_DATA1
+    }
+    /// FIFO_DATA pops and FIFO_COUNTH latches the count: the burst runs on a copy.
+    fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
+        spi_read_burst_on_copy(self, start, out);
     }
 }

@@ -6,7 +6,7 @@ use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion, PhysicalSample
 use margemu_protocol::regmap::ak8963;
 use margemu_protocol::regmap::mpu6xxx::{bits, is_read_only, next_address, reg, write_mask};
 
-use super::super::{Chip, I2cTarget, RegisterWrite, SpiTarget};
+use super::super::{spi_read_burst_on_copy, Chip, I2cTarget, RegisterWrite, SpiTarget};
 use super::Mpu6xxx;
 
 /// Registers whose SPI write does more than store `value & write_mask` (resets, FIFO pushes,
@@ -112,5 +112,17 @@ impl Chip for Mpu6xxx {
     }
     fn burst_start(&self) -> u8 {
         reg::ACCEL_XOUT_H
+    }
+    /// On a copy: FIFO_R_W pops, FIFO_COUNTH latches FIFO_COUNTL, status registers clear.
+    fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
+        spi_read_burst_on_copy(self, start, out);
+    }
+    /// The own address unless USER_CTRL.I2C_IF_DIS; the AK8963's in bypass mode.
+    fn i2c_addresses_now(&self) -> [Option<u8>; 2] {
+        let interface_on = self.peek(reg::USER_CTRL) & bits::USER_I2C_IF_DIS == 0;
+        [
+            interface_on.then(|| Mpu6xxx::i2c_address(self)),
+            self.bypass_active().then_some(ak8963::I2C_ADDRESS),
+        ]
     }
 }
