@@ -15,7 +15,9 @@
 //! - `read_sample()` (`ready.rs`): one SPI burst from INT_STATUS (0x2D) over FIFO_COUNTH/L into
 //!   FIFO_DATA (20 bytes); `Err(FifoOverflow)` if INT_STATUS.FIFO_FULL_INT, `None` if the header
 //!   says the FIFO is empty, else the decoded packet and whether more bytes than one packet were
-//!   counted.
+//!   counted. `read_fifo(&mut [u32])`: the same burst into a caller's buffer, returning
+//!   FIFO_COUNT / 20, the packets in the FIFO (not those that fit in the buffer); the caller
+//!   decodes the bytes with the crate's `FifoPacket4`.
 //!
 //! Each value is checked to within one LSB of the 20-bit format's resolution (4 codes for
 //! accel, 2 for gyro) in the units the crate returns: the sample becomes 20-bit codes at the
@@ -28,12 +30,16 @@
 //!   TEMP_DATA / 132.48 + 25; the 2.07 LSB/°C is the 8-bit FIFO_TEMP_DATA of packets 1–3), but
 //!   the crate divides it by 2.07 and reads it as **unsigned** (`temperature_raw() -> u16`):
 //!   30 °C (662) comes back as 344.8 °C and 20 °C (−662 → 64874) as 31 365 °C. The check
-//!   applies the crate's formula to the chip's 16-bit value.
+//!   applies the crate's formula to the chip's 16-bit value. (TDK's own ICM-426xx driver
+//!   agrees with the datasheet: its `TEMP_SENSITIVITY_2_BYTE` is 1/132.48 "for data register
+//!   and FIFO high res. data conversion".)
 
 use embedded_hal::spi::SpiDevice as _;
+use icm426xx::fifo::FifoPacket4;
 use icm426xx::{Config, Error, Sample, Timestamp, ICM42688};
 use margemu::bus::{self, Clock, Shared};
 use margemu_firmware::chip::{Icm42688p as Chip, PhysicalSample};
+use margemu_protocol::regmap::icm42688p::convert::{accel_to_raw20, gyro_to_raw20, temp_to_raw};
 
 /// Standard gravity, m/s² per g (the chip's g and the crate's `STD_GRAVITY`).
 const G: f64 = 9.80665;
@@ -351,5 +357,105 @@ fn a_full_fifo_is_reported_as_overflow() {
     assert!(matches!(icm.read_sample(), Err(Error::FifoOverflow)));
     // SIGNAL_PATH_RESET.FIFO_FLUSH through the crate empties it.
     icm.reset_fifo().unwrap();
+    assert!(icm.read_sample().unwrap().is_none());
+}
+
+/// One packet 4 from 20 FIFO bytes, as the crate's `FifoPacket4` (its fields in FIFO order).
+fn packet4(b: &[u8]) -> FifoPacket4 {
+    FifoPacket4 {
+        fifo_header: b[0],
+        accel_data_x1: b[1],
+        accel_data_x0: b[2],
+        accel_data_y1: b[3],
+        accel_data_y0: b[4],
+        accel_data_z1: b[5],
+        accel_data_z0: b[6],
+        gyro_data_x1: b[7],
+        gyro_data_x0: b[8],
+        gyro_data_y1: b[9],
+        gyro_data_y0: b[10],
+        gyro_data_z1: b[11],
+        gyro_data_z0: b[12],
+        temp_data1: b[13],
+        temp_data0: b[14],
+        timestamp_h: b[15],
+        timestamp_l: b[16],
+        ext_accel_x_gyro_x: b[17],
+        ext_accel_y_gyro_y: b[18],
+        ext_accel_z_gyro_z: b[19],
+    }
+}
+
+/// The packet's 20-bit codes, as the crate assembles them, are exactly the chip's conversion
+/// of the sample (bits 19:12, 11:4 and the extension nibbles in their places).
+fn assert_codes(k: usize, q: &FifoPacket4, p: &PhysicalSample) {
+    assert_eq!(
+        q.fifo_header, 0x78,
+        "packet {k}: ACCEL | GYRO | 20 | TIMESTAMP_ODR"
+    );
+    let accel = [q.accel_data_x(), q.accel_data_y(), q.accel_data_z()];
+    let gyro = [q.gyro_data_x(), q.gyro_data_y(), q.gyro_data_z()];
+    assert_eq!(accel, p.acc.map(accel_to_raw20), "packet {k} accel");
+    assert_eq!(gyro, p.gyr.map(gyro_to_raw20), "packet {k} gyro");
+    assert_eq!(
+        q.temperature_raw() as i16,
+        temp_to_raw(p.temp_c),
+        "packet {k} temp"
+    );
+}
+
+/// The bytes `read_fifo` left in its `u32` buffer (the crate casts the buffer to bytes in
+/// memory order): [command, INT_STATUS, FIFO_COUNTH, FIFO_COUNTL, FIFO data …].
+fn fifo_bytes(buf: &[u32]) -> Vec<u8> {
+    buf.iter().flat_map(|w| w.to_ne_bytes()).collect()
+}
+
+#[test]
+fn read_fifo_bursts_whole_and_partial_packets() {
+    let (chip, mut icm, _) = init();
+    let samples = samples(40);
+    let mut t = chip.borrow().now_ns();
+    for p in &samples[..25] {
+        t += PERIOD_NS;
+        chip.borrow_mut().latch_at(p, t);
+    }
+    // Room for 10 packets: it reports the 25 counted, the other 15 stay in the FIFO.
+    let mut buf = [0u32; (4 + 10 * 20) / 4];
+    assert_eq!(icm.read_fifo(&mut buf).unwrap(), 25);
+    let bytes = fifo_bytes(&buf);
+    assert_eq!(
+        u16::from_be_bytes([bytes[2], bytes[3]]),
+        25 * 20,
+        "FIFO_COUNT"
+    );
+    for (k, b) in bytes[4..].chunks_exact(20).enumerate() {
+        assert_codes(k, &packet4(b), &samples[k]);
+    }
+    // 28 data bytes: packet 10 whole and 8 bytes of packet 11. FIFO_RESUME_PARTIAL_RD is
+    // clear, so packet 11 is read again from its start (DS: FIFO_CONFIG1).
+    let mut buf = [0u32; 8];
+    assert_eq!(icm.read_fifo(&mut buf).unwrap(), 15);
+    let bytes = fifo_bytes(&buf);
+    assert_codes(10, &packet4(&bytes[4..24]), &samples[10]);
+    assert_eq!(bytes[24], 0x78, "packet 11's header");
+    // The rest, one packet at a time, then the other 15 samples in one burst.
+    for k in 11..25 {
+        let (s, more) = icm.read_sample().unwrap().unwrap();
+        assert_eq!(more, k < 24);
+        let mut w = Worst::default();
+        deviation(&mut w, &s, &samples[k]);
+        assert!(w.check.iter().all(|d| *d <= 1.0), "sample {k}: {w}");
+    }
+    assert!(icm.read_sample().unwrap().is_none());
+    for p in &samples[25..] {
+        t += PERIOD_NS;
+        chip.borrow_mut().latch_at(p, t);
+    }
+    let mut buf = [0u32; (4 + 15 * 20) / 4];
+    assert_eq!(icm.read_fifo(&mut buf).unwrap(), 15);
+    let bytes = fifo_bytes(&buf);
+    for (k, b) in bytes[4..].chunks_exact(20).enumerate() {
+        assert_codes(25 + k, &packet4(b), &samples[25 + k]);
+    }
     assert!(icm.read_sample().unwrap().is_none());
 }
