@@ -439,11 +439,11 @@ fn read_fifo_bursts_whole_and_partial_packets() {
     assert_codes(10, &packet4(&bytes[4..24]), &samples[10]);
     assert_eq!(bytes[24], 0x78, "packet 11's header");
     // The rest, one packet at a time, then the other 15 samples in one burst.
-    for k in 11..25 {
+    for (k, p) in samples.iter().enumerate().take(25).skip(11) {
         let (s, more) = icm.read_sample().unwrap().unwrap();
         assert_eq!(more, k < 24);
         let mut w = Worst::default();
-        deviation(&mut w, &s, &samples[k]);
+        deviation(&mut w, &s, p);
         assert!(w.check.iter().all(|d| *d <= 1.0), "sample {k}: {w}");
     }
     assert!(icm.read_sample().unwrap().is_none());
