@@ -459,3 +459,44 @@ fn read_fifo_bursts_whole_and_partial_packets() {
     }
     assert!(icm.read_sample().unwrap().is_none());
 }
+
+/// The interrupt-driven loop the crate is set up for: INT1 latched, active high, on FIFO_THS
+/// (20-byte watermark, WM_GT_TH), cleared by the first FIFO byte read (INT_CONFIG0
+/// FIFO_THS_INT_CLEAR = 10), not by the INT_STATUS read in the same burst.
+#[test]
+fn fifo_threshold_drives_int1() {
+    let (chip, mut icm, _) = init();
+    let pin = |chip: &Shared<Chip>| chip.borrow().int_pin();
+    assert_eq!(
+        reg(&chip, 0x65) & 0x14,
+        0x14,
+        "INT_SOURCE0: FIFO_THS, RESET_DONE (reset)"
+    );
+    // RESET_DONE_INT, routed to INT1 from reset, holds the latched pin until INT_STATUS is read.
+    assert!(pin(&chip), "RESET_DONE after the soft reset");
+    assert!(icm.read_sample().unwrap().is_none());
+    assert!(!pin(&chip), "INT_STATUS read");
+    let samples = samples(8);
+    let mut t = chip.borrow().now_ns();
+    let mut latch = |chip: &Shared<Chip>, p: &PhysicalSample| {
+        t += PERIOD_NS;
+        chip.borrow_mut().latch_at(p, t);
+    };
+    latch(&chip, &samples[0]);
+    assert!(pin(&chip), "one packet reaches the watermark");
+    assert!(!icm.read_sample().unwrap().unwrap().1);
+    assert!(!pin(&chip), "cleared by the FIFO read");
+    for p in &samples[1..4] {
+        latch(&chip, p);
+    }
+    assert!(pin(&chip));
+    let (_, more) = icm.read_sample().unwrap().unwrap();
+    assert!(
+        more && !pin(&chip),
+        "cleared by the first FIFO byte, 2 packets left"
+    );
+    assert!(icm.read_sample().unwrap().unwrap().1);
+    assert!(!icm.read_sample().unwrap().unwrap().1);
+    latch(&chip, &samples[4]);
+    assert!(pin(&chip), "WM_GT_TH: the next packet raises it again");
+}
