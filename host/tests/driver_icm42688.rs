@@ -18,16 +18,37 @@
 //!   `gyro_norm` **°/s** (raw / LSB per °/s: 16.4 … 2097.2, the datasheet's), `temperature`
 //!   °C (raw / 132.48 + 25).
 //!
+//! - FIFO (`new_fifo`, "development use" helpers): FIFO stop-on-full, timestamps (1 µs deltas),
+//!   FIFO_CONFIG1 for packet 1, 2, 3 or 4, both ODRs 1 kHz, ±16 g / ±2000 °/s, sensors on with
+//!   temperature; `read_fifo(addr, buf)` is one I2C burst, `read_fifo_cnt` two register reads,
+//!   `FifoDataP1`…`P4::to_fifodata_raw` decode packets. Crate bugs met there, worked around
+//!   in `fifo_packets_over_i2c` (each against DS-000347's register map and descriptions):
+//!   `SIGNAL_PATH_RESET` is 0x48 in its `register.rs`, the datasheet's is 0x4B, so its FIFO
+//!   flush writes a reserved address (harmless here: nothing was latched yet); `read_fifo_cnt`
+//!   reads FIFO_COUNTL before FIFO_COUNTH, but reading FIFO_COUNTH is what latches both
+//!   (FIFO_COUNTL: "Must read FIFO_COUNTH to latch new data"), so its low byte is the previous
+//!   latch's: it is called twice; `FifoDataSiP2` takes the gyro of packet 2 from bytes 7–12
+//!   (packet 2 has it in 1–6, as its own `FifoDataP2` reads it), so only the raw decoders
+//!   are checked for packets 1–3. The SI conversions use g = 9.81 (350 ppm above the standard
+//!   gravity the chip's sensitivity is in).
+//!
 //! For every accel × gyro full scale, samples are latched between driver calls: zero, ±1 LSB,
 //! ±full scale and beyond it (saturation), negative values, −40 … 85 °C; every value the crate
 //! returns must be within one LSB of the latched sample (clipped as the register clips).
 
 use embedded_hal_compat::{Reverse, ReverseCompat};
 use icm42688::prelude::*;
-use icm42688::{AccelRange, Address, Error, GyroRange, I2cSlewRate, PowerMode};
+use icm42688::{
+    AccelRange, Address, Error, FifoDataP1, FifoDataP2, FifoDataP3, FifoDataP4, FifoDataSiP4,
+    FifoPacketType, GyroRange, I2cSlewRate, PowerMode,
+};
 use margemu::bus::{self, Clock, Shared};
 use margemu_firmware::chip::icm42688p::Config;
 use margemu_firmware::chip::{Icm42688p as Chip, PhysicalSample};
+use margemu_protocol::regmap::icm42688p::convert::{
+    accel_to_raw, accel_to_raw20, fifo_temp8, gyro_to_raw, gyro_to_raw20, temp_to_raw,
+};
+use margemu_protocol::regmap::icm42688p::{AccelFs, GyroFs};
 
 /// Standard gravity, m/s² per g.
 const G: f64 = 9.80665;
@@ -338,4 +359,125 @@ fn new_i2c_slew_resets_and_sets_the_slew_rate() {
     assert_eq!(icm.accel_range().unwrap(), AccelRange::G16);
     assert_eq!(chip.borrow().peek(0, 0x4E), 0x2F, "PWR_MGMT0");
     assert_eq!(chip.borrow().peek(0, 0x76), 0, "REG_BANK_SEL");
+}
+
+/// `new_fifo` for each packet type, then 20 samples latched 1 ms apart (the ODR it sets) and
+/// read in one `read_fifo` burst, each packet decoded by the crate: the codes must be exactly
+/// the chip's conversion of the sample (16-bit at ±16 g / ±2000 °/s, 8-bit FIFO temperature,
+/// 20-bit; 1 µs timestamp deltas), packet 4's SI values within 1 LSB in the crate's units.
+#[test]
+fn fifo_packets_over_i2c() {
+    let packets = [
+        (FifoPacketType::Packet1, 0x05, 0x40, 8),
+        (FifoPacketType::Packet2, 0x06, 0x20, 8),
+        (FifoPacketType::Packet3, 0x07, 0x68, 16),
+        (FifoPacketType::Packet4, 0x17, 0x78, 20),
+    ];
+    for (n, (kind, config1, header, len)) in packets.into_iter().enumerate() {
+        let (chip, address) = chip(n % 2 == 1);
+        let mut delay = ChipDelay {
+            clock: Clock::new(),
+            chip: chip.clone(),
+        };
+        let mut icm = Icm::new_fifo(connect(&chip), address, kind, &mut delay).unwrap();
+        let peek = |addr| chip.borrow().peek(0, addr);
+        assert_eq!(peek(0x16), 0x80, "FIFO_CONFIG: stop on full");
+        assert_eq!(peek(0x5F), config1, "FIFO_CONFIG1");
+        assert_eq!(
+            peek(0x54),
+            0x37,
+            "TMST_CONFIG: TO_REGS, DELTA, (FSYNC), EN; 1 µs"
+        );
+        assert_eq!(
+            (peek(0x4F), peek(0x50)),
+            (0x06, 0x06),
+            "±2000 °/s, ±16 g, 1 kHz"
+        );
+        assert_eq!(
+            peek(0x4E),
+            0x0F,
+            "PWR_MGMT0: six axes low noise, temperature on"
+        );
+        assert_eq!(
+            peek(0x48),
+            0,
+            "its SIGNAL_PATH_RESET (0x48) is reserved: ignored"
+        );
+        let samples = samples(16.0, 2048.0, 2000.0, 16.4, 42 + n as u64);
+        let samples = &samples[..20];
+        let mut t = chip.borrow().now_ns();
+        for p in samples {
+            t += PERIOD_NS;
+            chip.borrow_mut().latch_at(p, t);
+        }
+        let count = (samples.len() * len) as u16;
+        // FIFO_COUNTL before FIFO_COUNTH: the first call's low byte is the reset latch (0).
+        assert_eq!(icm.read_fifo_cnt().unwrap(), count & 0xFF00);
+        assert_eq!(icm.read_fifo_cnt().unwrap(), count);
+        let mut buf = vec![0u8; usize::from(count)];
+        assert_eq!(icm.read_fifo(0x30, &mut buf).unwrap(), header);
+        let mut worst = [0f64; 2];
+        for (k, (b, p)) in buf.chunks_exact_mut(len).zip(samples).enumerate() {
+            assert_eq!(b[0], header, "{kind:?} {k}");
+            let accel16 = p.acc.map(|a| accel_to_raw(a, AccelFs::G16));
+            let gyro16 = p.gyr.map(|w| gyro_to_raw(w, GyroFs::Dps2000));
+            let temp8 = fifo_temp8(temp_to_raw(p.temp_c));
+            let delta = if k == 0 { 0 } else { 1000 };
+            match kind {
+                FifoPacketType::Packet1 => {
+                    let d = FifoDataP1::to_fifodata_raw(b);
+                    assert_eq!(([d.ax, d.ay, d.az], d.t), (accel16, temp8), "{kind:?} {k}");
+                }
+                FifoPacketType::Packet2 => {
+                    let d = FifoDataP2::to_fifodata_raw(b);
+                    assert_eq!(([d.gx, d.gy, d.gz], d.t), (gyro16, temp8), "{kind:?} {k}");
+                }
+                FifoPacketType::Packet3 => {
+                    let d = FifoDataP3::to_fifodata_raw(b);
+                    let got = ([d.ax, d.ay, d.az], [d.gx, d.gy, d.gz], d.t, d.ts);
+                    assert_eq!(got, (accel16, gyro16, temp8, delta), "{kind:?} {k}");
+                }
+                FifoPacketType::Packet4 => {
+                    let d = FifoDataP4::to_fifodata_raw(b);
+                    let got = ([d.ax, d.ay, d.az], [d.gx, d.gy, d.gz], d.t, d.ts);
+                    let want = (
+                        p.acc.map(accel_to_raw20),
+                        p.gyr.map(gyro_to_raw20),
+                        temp_to_raw(p.temp_c),
+                        delta,
+                    );
+                    assert_eq!(got, want, "{kind:?} {k}");
+                    // SI: m/s² on its g = 9.81 and rad/s, against the clipped sample in codes
+                    // (18-bit accel in steps of 4, 19-bit gyro in steps of 2).
+                    let si = FifoDataSiP4::to_fifodata_si(&d);
+                    let a_unit = 9.81 / 32768.0;
+                    let g_unit = 1.0 / (262.0 * DEG_PER_RAD);
+                    for (i, got) in [si.ax, si.ay, si.az].into_iter().enumerate() {
+                        let ideal = (f64::from(p.acc[i]) / G * 8192.0).clamp(-131071.0, 131071.0);
+                        let dev = (f64::from(got) / a_unit / 4.0 - ideal).abs();
+                        worst[0] = worst[0].max(dev);
+                    }
+                    for (i, got) in [si.gx, si.gy, si.gz].into_iter().enumerate() {
+                        let ideal =
+                            (f64::from(p.gyr[i]) * DEG_PER_RAD * 131.0).clamp(-262143.0, 262143.0);
+                        let dev = (f64::from(got) / g_unit / 2.0 - ideal).abs();
+                        worst[1] = worst[1].max(dev);
+                    }
+                    let temp = (f64::from(si.t) - 25.0) * TEMP_LSB_PER_C;
+                    assert!((temp - f64::from(temp_to_raw(p.temp_c))).abs() < 0.01);
+                }
+            }
+        }
+        assert!(
+            worst.iter().all(|d| *d <= 1.0),
+            "{kind:?} SI: {worst:?} LSB"
+        );
+        // Now empty: the first call pairs the new high byte (0) with the old low byte.
+        assert_eq!(
+            icm.read_fifo_cnt().unwrap(),
+            count & 0x00FF,
+            "stale low byte"
+        );
+        assert_eq!(icm.read_fifo_cnt().unwrap(), 0, "FIFO empty");
+    }
 }
