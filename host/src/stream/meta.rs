@@ -105,6 +105,8 @@ pub(super) fn metadata(
                 gyro_offset: i.gyro_offset,
                 accel_offset: i.accel_offset,
             }),
+            // Full scales only: `[chip]` records them (accel_range_g, gyro_range_dps).
+            Conversion::Icm42688p(_) => None,
         },
         scene_text: &scene.text,
     };
