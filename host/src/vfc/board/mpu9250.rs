@@ -22,7 +22,7 @@
 //! no settling time, and the time asked for is reported.
 //!
 //! **Axes.** The body frame is the MPU-9250's accel/gyro frame; the AK8963's reading is turned
-//! into it with the configured [`MagAlignment`] ([`to_body`], [`super::super::axes`]).
+//! into it with the configured [`MagAlignment`] ([`to_body`], [`crate::vfc::axes`]).
 
 use super::Reading;
 use crate::bus::{self, Shared};
@@ -219,7 +219,7 @@ impl Board {
     }
 
     /// Reads accelerometer, temperature, gyroscope and magnetometer with the driver's burst
-    /// (`all`), in the driver's units (see [`super::axes`]); the read clears INT.
+    /// (`all`), in the driver's units (see [`crate::vfc::axes`]); the read clears INT.
     pub fn read(&mut self, chip: &mut Chip) -> Result<MargMeasurements<[f32; 3]>, String> {
         let Self { slot, driver, .. } = self;
         on_bus(slot, chip, || {
