@@ -18,7 +18,7 @@
 //! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged;
 //! - [`offline`]: the reference filters (`margemu-filters`) run over recorded samples, estimates written;
 //! - [`tune`](mod@tune): a filter's parameters tuned on a scene over several seeds (Nelder–Mead, eq. 27);
-//! - [`vfc`]: a virtual flight controller on the loopback device (the `mpu9250` driver, a reference filter, MAVLink out);
+//! - [`vfc`]: a virtual flight controller on the loopback device (the chip's third-party driver, `mpu9250` or `icm426xx`, a reference filter, MAVLink out);
 //! - [`demo`]: the case study through loopback with the virtual flight controller (Table 3).
 #![warn(missing_docs)]
 

@@ -109,6 +109,69 @@ fn loopback_with_a_flight_controller_reads_back_and_scores_its_mavlink() {
 }
 
 #[test]
+fn loopback_with_a_flight_controller_on_the_icm42688p_reads_back_and_scores_its_mavlink() {
+    let dir = scratch("vfc-icm");
+    let session = dir.join("session");
+    let out = margemu(&[
+        "loopback",
+        path(&dir.join("scene.toml")),
+        "--chip",
+        "icm42688p",
+        "-o",
+        path(&session),
+        "--vfc",
+        "ekf",
+    ]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    assert!(
+        all.contains("over SPI: ICM-42688-P WHO_AM_I 0x47, no magnetometer (heading from the gyroscope alone); 400 samples read (0 warm-up), 0 missed;"),
+        "{all}"
+    );
+    assert!(all.contains("400 skipped mag"), "{all}");
+    assert!(
+        all.contains("400 of 400 predicted images confirmed byte for byte"),
+        "{all}"
+    );
+    assert!(
+        all.contains("every frame the flight controller sent was decoded"),
+        "{all}"
+    );
+    assert!(all.contains("geodesic RMS (rad)"), "{all}");
+    assert!(session.join("report.md").is_file());
+    let (_, rows) = csv(&session, "dut_attitude.csv");
+    assert_eq!(rows.len(), 200);
+    let meta: toml::Table = std::fs::read_to_string(session.join("meta.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(meta["chip"]["model"].as_str(), Some("icm42688p"));
+    assert_eq!(meta["chip"]["accel_range_g"].as_float(), Some(16.0));
+    assert_eq!(meta["chip"]["gyro_range_dps"].as_float(), Some(2000.0));
+}
+
+#[test]
+fn loopback_refuses_a_flight_controller_on_a_chip_without_a_driver() {
+    let dir = scratch("vfc-mpu6500");
+    let out = margemu(&[
+        "loopback",
+        path(&dir.join("scene.toml")),
+        "--chip",
+        "mpu6500",
+        "-o",
+        path(&dir.join("session")),
+        "--vfc",
+        "ekf",
+    ]);
+    assert!(!out.status.success());
+    let all = text(&out);
+    assert!(
+        all.contains("the virtual flight controller has no driver for the MPU-6500"),
+        "{all}"
+    );
+}
+
+#[test]
 fn a_bad_parameters_file_is_refused_with_its_location() {
     let dir = scratch("bad-params");
     std::fs::write(dir.join("params.toml"), "[ekf]\nmag_noise = -0.5\n").unwrap();

@@ -39,7 +39,7 @@ impl Cmd {
         });
         let vfc = self.vfc.config(&scene)?;
         let settings = match vfc {
-            Some(_) => margemu::vfc::image_settings(&scene),
+            Some(_) => margemu::vfc::image_settings(&scene)?,
             None => ImageSettings::for_scene(&scene),
         };
         let (host_end, device_end) = TTYPort::pair().context("opening a pseudo-terminal pair")?;
@@ -55,7 +55,7 @@ impl Cmd {
         let mut session = prepare(&scene, config, &dir)?;
         let (device, dut) = match vfc {
             Some(cfg) => {
-                let expected = margemu::vfc::board::chip_settings();
+                let expected = settings.chip;
                 let (rig, port) = margemu::vfc::spawn(device_end, cfg, expected)?;
                 let config = DutConfig::new(DutProtocol::Mavlink);
                 let dut = margemu::vfc::attach(&mut session, port, config, &dir)?;

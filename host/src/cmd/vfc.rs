@@ -11,9 +11,11 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct VfcArgs {
-    /// Run a virtual flight controller with this filter on the emulated chip: the `mpu9250`
-    /// driver over the virtual bus, MAVLink ATTITUDE/ATTITUDE_QUATERNION read back through a
-    /// second PTY pair into dut_*.csv and scored at the end.
+    /// Run a virtual flight controller with this filter on the emulated chip: its driver over
+    /// the virtual bus (`mpu9250` on the MPU-9250; `icm426xx` on the ICM-42688-P, which has no
+    /// magnetometer: heading from the gyroscope alone, compare roll and pitch), MAVLink
+    /// ATTITUDE/ATTITUDE_QUATERNION read back through a second PTY pair into dut_*.csv and
+    /// scored at the end.
     #[arg(long, conflicts_with = "dut", value_name = "ecf|gda|ekf")]
     pub vfc: Option<FilterKind>,
     /// The filter's parameters (TOML: [ecf] kp, ki; [gda] beta; [ekf] gyro_noise,

@@ -2,16 +2,27 @@
 //! loop ([`crate::loopback::spawn_device_with_local`]) with the firmware `Device` it sits on.
 //!
 //! 1. While the device is idle there is nothing to do. Once it is configured (the chip of the
-//!    session exists), the board sets the chip up through the driver ([`Board::init`]) and
-//!    checks that the chip now converts samples the way the host predicted its images; a
-//!    mismatch ends the device loop with the reason (the session then fails with it). A new
-//!    Hello (the device back to idle) starts over.
-//! 2. At each turn, the INT pin: when it says data ready, the driver reads the sample (clearing
-//!    INT), [`to_body`] turns it into SI body axes, and the filter takes it with `dt` = the time
-//!    since the previous sample's data-ready edge. The filter starts with the first sample that
-//!    carries a magnetometer measurement (the AK8963 delivers its first one a period of its own
-//!    after set-up; a start without it would take yaw 0); the samples before are counted as
-//!    warm-up.
+//!    session exists), the board of the chip's model sets the chip up through its driver
+//!    ([`Board::init`]) and checks that the chip now converts samples the way the host
+//!    predicted its images; a mismatch ends the device loop with the reason (the session then
+//!    fails with it). A new Hello (the device back to idle) starts over.
+//! 2. At each turn, the INT pin: when it says data ready, the driver reads what is waiting
+//!    (clearing INT): one sample on the MPU-9250, every FIFO packet on the ICM-42688-P. The
+//!    board turns each into SI body axes ([`Board::to_body`]), and the filter takes it with
+//!    `dt` = the time since the previous sample's data-ready edge. On a chip with a
+//!    magnetometer the filter starts with the first sample that carries a measurement (the
+//!    AK8963 delivers its first one a period of its own after set-up; a start without it would
+//!    take yaw 0); the samples before are counted as warm-up.
+//!
+//! **Without a magnetometer** (ICM-42688-P) the filter gets a zero field with every sample. The
+//! filters of `margemu-filters` take that as an unusable magnetometer: they skip the
+//! magnetometer correction and count it (`skipped_mag`, one per sample), and the first sample
+//! sets the tilt only, at yaw 0 (TRIAD without a field). So the heading reported is the one the
+//! filters have without a magnetometer: 0 at the first sample, then the integrated gyroscope
+//! (the EKF's bias estimate is then driven by gravity alone, which does not observe the bias
+//! about the vertical). Roll and pitch are corrected by the accelerometer as with a
+//! magnetometer; the yaw error is the truth's heading at the first sample plus the drift, so
+//! compare roll and pitch (a geodesic score includes the yaw error).
 //! 3. The output: at the configured rate on the device clock, or after every sample, an
 //!    ATTITUDE and an ATTITUDE_QUATERNION (MAVLink 2, [`crate::dut::mavlink_out`]) with `time_boot_ms` =
 //!    the sample's instant; a HEARTBEAT every second. Frames go to the UART queue.
@@ -23,9 +34,11 @@
 //! after the edge; when the host starves the device thread for longer than a sample period, a
 //! sample latched over before it was read is lost to the flight controller, as on a board that
 //! misses an interrupt, and counted in [`FcReport::missed`] (the filter's `dt` spans the gap).
+//! A FIFO keeps such samples: the newest packet read is the last sample served, each older one
+//! a sample period earlier. Only a FIFO overflow (flushed, [`FcReport::overflows`]) loses them.
 
-use super::axes::to_body;
-use super::board::Board;
+use super::axes::BodySample;
+use super::board::{self, Board};
 use super::uart::UartTx;
 use super::{OutputRate, VfcConfig};
 use crate::dut::mavlink_out::{attitude, attitude_quaternion, MavlinkWriter};
@@ -33,11 +46,8 @@ use crate::loopback::Firmware;
 use crate::offline::ParamError;
 use margemu_filters::{AttitudeFilter, Diagnostics, Imu, Initial};
 use margemu_firmware::chip::EmulatedChip;
-use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion};
+use margemu_protocol::chip::ChipSettings;
 use margemu_protocol::link::DeviceState;
-
-/// The virtual flight controller runs the `mpu9250` driver: it needs an MPU-9250.
-const NOT_AN_MPU9250: &str = "the virtual flight controller's driver needs an MPU-9250";
 use mavlink::dialects::common::{
     MavAutopilot, MavMessage, MavModeFlag, MavState, MavType, HEARTBEAT_DATA,
 };
@@ -52,17 +62,24 @@ pub struct FcReport {
     pub filter: String,
     /// The bus the driver used (`SPI` or `I2C`).
     pub bus: &'static str,
-    /// What the driver found at set-up (the last set-up, if the device was configured again).
-    pub init: Option<super::board::InitReport>,
+    /// What the board's driver did at set-up (the last set-up, if the device was configured
+    /// again).
+    pub setup: Option<board::Setup>,
+    /// What the `mpu9250` driver found at set-up, on an MPU-9250 ([`board::Setup::mpu9250`]).
+    pub init: Option<board::InitReport>,
     /// Set-ups done.
     pub inits: u64,
     /// Samples read on data ready.
     pub samples: u64,
-    /// Samples read before the first magnetometer measurement (not filtered).
+    /// Samples read before the first magnetometer measurement (not filtered; chips with a
+    /// magnetometer only).
     pub warmup: u64,
     /// Samples never read: latched over by the next one before the flight controller saw its
-    /// data-ready (from the gaps between the instants of the samples read).
+    /// data-ready, or flushed with an overflowing FIFO (from the gaps between the instants of
+    /// the samples read).
     pub missed: u64,
+    /// FIFO overflows (each flushed the FIFO).
+    pub overflows: u64,
     /// Frames queued per MAVLink message name.
     pub sent: BTreeMap<&'static str, u64>,
     /// Frames dropped because the UART queue was full.
@@ -118,7 +135,7 @@ impl VirtualFc {
                 config.filter.kind(),
                 super::describe(&config.filter)
             );
-            r.bus = super::board::BUS;
+            r.bus = board::bus(expected.model).unwrap_or("no bus");
         }
         Ok(Self {
             config,
@@ -160,16 +177,33 @@ impl VirtualFc {
             return Ok(());
         };
         let t_ns = device.last_served().map_or(0, |s| s.time_ns);
-        let EmulatedChip::Mpu6xxx(chip) = device.chip_mut() else {
-            return Err(NOT_AN_MPU9250.into());
-        };
-        if !board.data_ready(chip) {
+        let chip: &mut EmulatedChip = device.chip_mut();
+        if !board.data_ready(chip)? {
             return Ok(());
         }
-        let m = board
+        let readings = board
             .read(chip)
             .map_err(|e| format!("reading the chip: {e}"))?;
-        let body = to_body(m.accel, m.gyro, m.mag, &self.config.mag_alignment);
+        let overflows = board.overflows();
+        let with_mag = board.has_magnetometer();
+        let bodies: Vec<BodySample> = readings
+            .iter()
+            .map(|r| board.to_body(r, &self.config.mag_alignment))
+            .collect();
+        self.update(|r| r.overflows = overflows);
+        let period_ns = 1e9 / self.config.sample_rate_hz;
+        let n = bodies.len();
+        for (i, body) in bodies.into_iter().enumerate() {
+            // The newest sample read is the last one served; a FIFO's older ones came a
+            // period apart before it.
+            let back_ns = ((n - 1 - i) as f64 * period_ns).round() as u64;
+            self.take(t_ns.saturating_sub(back_ns), body, with_mag);
+        }
+        Ok(())
+    }
+
+    /// One sample read, at the instant `t_ns`: counted, then filtered and sent.
+    fn take(&mut self, t_ns: u64, body: BodySample, with_mag: bool) {
         let period_ns = 1e9 / self.config.sample_rate_hz;
         // Samples since the previous read (the first instant of the device clock is 0).
         let gap_ns = match self.last_read_ns {
@@ -178,14 +212,14 @@ impl VirtualFc {
         };
         self.last_read_ns = Some(t_ns);
         let missed = ((gap_ns / period_ns).round() as u64).saturating_sub(1);
-        let warmup = self.last_ns.is_none() && body.mag_ut == [0.0; 3];
+        let warmup = with_mag && self.last_ns.is_none() && body.mag_ut == [0.0; 3];
         self.update(|r| {
             r.samples += 1;
             r.missed += missed;
             r.warmup += u64::from(warmup);
         });
         if warmup {
-            return Ok(());
+            return;
         }
         let dt_ns = match self.last_ns {
             Some(last) => t_ns.saturating_sub(last) as f64,
@@ -201,20 +235,18 @@ impl VirtualFc {
         let diagnostics = self.filter.diagnostics();
         self.update(|r| r.diagnostics = diagnostics);
         self.output(t_ns, body.gyro);
-        Ok(())
     }
 
     /// Sets the device's chip up and checks its conversion against the host's prediction.
     fn set_up(&mut self, device: &mut Firmware) -> Result<Board, String> {
-        let EmulatedChip::Mpu6xxx(chip) = device.chip_mut() else {
-            return Err(NOT_AN_MPU9250.into());
-        };
-        let (board, init) = Board::init(chip, self.config.sample_rate_hz)
-            .map_err(|e| format!("setting the chip up through the mpu9250 driver: {e}"))?;
-        let configured = ChipSettings {
-            model: ChipModel::Mpu9250,
-            conversion: Conversion::Mpu6xxx(init.image),
-        };
+        let (board, setup) = Board::init(device.chip_mut(), self.config.sample_rate_hz)?;
+        let configured = setup.configured;
+        if configured.model != self.expected.model {
+            return Err(format!(
+                "the board set up a {:?}, but the host computed its images for a {:?}",
+                configured.model, self.expected.model
+            ));
+        }
         if configured != self.expected {
             return Err(format!(
                 "the driver configured the chip as {:?}, but the host computed its images for {:?}",
@@ -231,7 +263,8 @@ impl VirtualFc {
         self.next_out = 0;
         self.next_heartbeat_ns = 0;
         self.update(|r| {
-            r.init = Some(init);
+            r.init = setup.mpu9250;
+            r.setup = Some(setup);
             r.inits += 1;
         });
         Ok(board)
@@ -302,22 +335,37 @@ fn heartbeat() -> MavMessage {
 impl std::fmt::Display for FcReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{} over {}: ", self.filter, self.bus)?;
-        match &self.init {
-            Some(i) => write!(
+        match (&self.init, &self.setup) {
+            (Some(i), _) => write!(
                 f,
                 "WHO_AM_I {:#04x}, AK8963 {:#04x}",
                 i.who_am_i, i.ak8963_wia
             )?,
-            None => f.write_str("chip never set up")?,
+            (None, Some(s)) => write!(
+                f,
+                "{} WHO_AM_I {:#04x}{}",
+                s.model.part_name(),
+                s.who_am_i,
+                if s.model.has_magnetometer() {
+                    ""
+                } else {
+                    ", no magnetometer (heading from the gyroscope alone)"
+                }
+            )?,
+            (None, None) => f.write_str("chip never set up")?,
         }
         let sent: Vec<String> = self.sent.iter().map(|(m, n)| format!("{m} {n}")).collect();
         let d = &self.diagnostics;
         write!(
             f,
-            "; {} samples read ({} warm-up), {} missed; sent {}; {} dropped; filter: {} skipped updates, {} skipped accel, {} skipped mag, {} rejected",
+            "; {} samples read ({} warm-up), {} missed{}; sent {}; {} dropped; filter: {} skipped updates, {} skipped accel, {} skipped mag, {} rejected",
             self.samples,
             self.warmup,
             self.missed,
+            match self.overflows {
+                0 => String::new(),
+                n => format!(" ({n} FIFO overflows)"),
+            },
             if sent.is_empty() { "nothing".into() } else { sent.join(", ") },
             self.dropped,
             d.skipped_updates,

@@ -36,6 +36,8 @@ pub enum VfcError {
     Stream(#[from] StreamError),
     /// {0}
     Dut(#[from] DutError),
+    /// {0}
+    NoBoard(#[from] super::board::NoBoard),
 }
 
 /// The device with its flight controller, running.
@@ -91,7 +93,7 @@ impl VfcRig {
 
 /// Starts the firmware device on `device_port` with a flight controller of `config` in its
 /// thread; `expected` is the conversion the host computes images with
-/// ([`super::board::chip_settings`]). Returns the rig and the host end of the flight
+/// ([`super::board::chip_settings`] of the scene's chip). Returns the rig and the host end of the flight
 /// controller's UART (a PTY with a 5 ms read timeout).
 pub fn spawn(
     device_port: TTYPort,
@@ -233,11 +235,11 @@ pub fn run_loopback(
         port: device_end
             .name()
             .unwrap_or_else(|| "a pseudo-terminal".into()),
-        images: Some(super::image_settings(scene)),
+        images: Some(super::image_settings(scene)?),
         ..stream
     };
+    let expected = super::board::chip_settings(scene.chip.model)?;
     let mut session = Session::new(scene, stream, dir)?;
-    let expected = super::board::chip_settings();
     let (rig, fc_port) = spawn(device_end, config, expected)?;
     let dut = match attach(
         &mut session,

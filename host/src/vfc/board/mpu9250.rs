@@ -1,6 +1,6 @@
-//! The flight controller's board: the emulated MPU-9250 on its bus, driven by the unmodified
-//! `mpu9250` crate (embedded-hal 0.2) through margemu's embedded-hal 1.0 adapters
-//! ([`crate::bus`]) and `embedded-hal-compat`.
+//! The MPU-9250 board: the emulated MPU-9250 on its bus, driven by the unmodified `mpu9250`
+//! crate (embedded-hal 0.2) through margemu's embedded-hal 1.0 adapters ([`crate::bus`]) and
+//! `embedded-hal-compat`.
 //!
 //! **Bus.** SPI in MARG mode by default (the AK8963 behind the chip's auxiliary I2C master, read
 //! with the accelerometer and gyroscope in one 21-byte burst); with the `mpu9250-i2c` feature,
@@ -20,8 +20,13 @@
 //! read). [`Board::data_ready`] reads that pin's level, as a GPIO. The driver's delays do not
 //! sleep and do not move the chip's clock (the device's scene clock): the emulated chip needs
 //! no settling time, and the time asked for is reported.
+//!
+//! **Axes.** The body frame is the MPU-9250's accel/gyro frame; the AK8963's reading is turned
+//! into it with the configured [`MagAlignment`] ([`to_body`], [`crate::vfc::axes`]).
 
+use super::Reading;
 use crate::bus::{self, Shared};
+use crate::vfc::axes::{BodySample, MagAlignment};
 use embedded_hal_compat::ReverseCompat;
 use margemu_firmware::chip::Mpu6xxx as Chip;
 use margemu_protocol::regmap::ak8963::MagBits;
@@ -215,12 +220,34 @@ impl Board {
     }
 
     /// Reads accelerometer, temperature, gyroscope and magnetometer with the driver's burst
-    /// (`all`), in the driver's units (see [`super::axes`]); the read clears INT.
+    /// (`all`), in the driver's units (see [`crate::vfc::axes`]); the read clears INT.
     pub fn read(&mut self, chip: &mut Chip) -> Result<MargMeasurements<[f32; 3]>, String> {
         let Self { slot, driver, .. } = self;
         on_bus(slot, chip, || {
             driver.all::<[f32; 3]>().map_err(|e| format!("{e:?}"))
         })
+    }
+}
+
+/// The driver's burst as a [`Reading`]: m/s² and rad/s in the chip's axes, the field in µT in
+/// the AK8963's axes (the driver gives milligauss; 1 µT = 10 mG).
+pub fn reading(m: &MargMeasurements<[f32; 3]>) -> Reading {
+    let wide = |v: [f32; 3]| v.map(f64::from);
+    Reading {
+        acc: wide(m.accel),
+        gyro: wide(m.gyro),
+        mag_ut: Some(wide(m.mag).map(|mg| mg * 0.1)),
+    }
+}
+
+/// A [`Reading`] of this board in body axes: accelerometer and gyroscope as they are, the
+/// magnetometer turned by `alignment` (the same values as [`crate::vfc::axes::to_body`] of the driver's
+/// burst).
+pub fn to_body(r: &Reading, alignment: &MagAlignment) -> BodySample {
+    BodySample {
+        gyro: r.gyro,
+        acc: r.acc,
+        mag_ut: alignment.apply(r.mag_ut.unwrap_or_default()),
     }
 }
 
@@ -259,7 +286,8 @@ mod tests {
         assert!(board.data_ready(&chip));
         let m = board.read(&mut chip).unwrap();
         assert!(!board.data_ready(&chip), "the read clears INT");
-        let body = super::super::axes::to_body(m.accel, m.gyro, m.mag, &Default::default());
+        let body = crate::vfc::axes::to_body(m.accel, m.gyro, m.mag, &Default::default());
+        assert_eq!(to_body(&reading(&m), &Default::default()), body);
         for i in 0..3 {
             assert!(
                 (body.acc[i] - f64::from(sample.acc[i])).abs() < 0.01,
