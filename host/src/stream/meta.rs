@@ -105,6 +105,8 @@ pub(super) fn metadata(
                 gyro_offset: i.gyro_offset,
                 accel_offset: i.accel_offset,
             }),
+            // The ICM-42688-P's settings are its full scales, in `[chip]` already.
+            Conversion::Icm42688p(_) => None,
         },
         scene_text: &scene.text,
     };
