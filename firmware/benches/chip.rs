@@ -1,21 +1,39 @@
-//! Cost of the emulated MPU-9250's two hot paths:
+//! Cost of the emulated chips' hot paths.
+//!
+//! MPU-9250 in the `mpu9250` crate's MARG setup ([`Mpu6xxx`] directly):
 //! (1) a physical sample → register image (`latch`: conversion, AK8963, aux master, FIFO,
 //!     interrupt, swap) and a register image (`latch_image`);
 //! (2) a 22-byte SPI burst (address byte 0x80 | 0x3B + 21 data bytes, ACCEL_XOUT_H through
 //!     EXT_SENS_DATA_06, as the `mpu9250` crate reads a MARG sample) through the SPI target
 //!     state machine: select, 22 exchanges, deselect.
 //!
+//! Every chip model the firmware emulates (`EmulatedChip::models()`; the protocol's MPU-6000
+//! and ICM-20602 have their images and conversions but no emulated chip yet), through the chip
+//! boundary (`EmulatedChip::new(model, model.who_am_i(), 0x68)` and the `Chip` trait), sensors
+//! on, otherwise at power-on:
+//! (3) `chip image/<model>`: a physical sample → the model's register image on the host side
+//!     (`ChipSettings::image`, what source mode (a) streams; every `ChipModel`);
+//! (4) `chip latch_image_at/<model>`: latching that image into the emulated chip;
+//! (5) `chip latch_at/<model>`: latching the physical sample (the chip converts; source mode (b));
+//! (6) `chip spi burst/<model>`: select + the model's data burst + deselect: MPU family
+//!     0x80 | 0x3B + 14 bytes (accel, temp, gyro), ICM-42688-P 0x80 | 0x1D + 14 bytes (temp,
+//!     accel, gyro), and for the ICM a 20-byte FIFO packet (0x80 | 0x30 + 20 bytes, the FIFO in
+//!     stream mode with 20-bit packets: FIFO_CONFIG1 HIRES + TEMP + GYRO + ACCEL), refilled
+//!     between timed reads.
+//!
 //! The requirement: well under one byte time of a 20 MHz SPI clock (400 ns) per byte.
 //!
-//! `cargo bench -p margemu-firmware -- --warm-up-time 1 --measurement-time 3`
+//! `cargo bench -p margemu-firmware --bench chip -- --warm-up-time 1 --measurement-time 3`
 
 // criterion_group! generates an undocumented public function.
 #![allow(missing_docs)]
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use margemu_firmware::chip::{Mpu6xxx, PhysicalSample, SpiTarget};
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use margemu_firmware::chip::{Chip, EmulatedChip, Mpu6xxx, PhysicalSample, SpiTarget};
+use margemu_protocol::chip::{ChipModel, ChipSettings, Family};
 use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
 use std::hint::black_box;
+use std::time::{Duration, Instant};
 
 const BURST: usize = 22;
 
@@ -114,5 +132,160 @@ fn burst(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, latch, burst);
+/// One SPI transaction: select, `bytes`, deselect.
+fn spi_write(chip: &mut EmulatedChip, bytes: &[u8]) {
+    chip.select();
+    for &b in bytes {
+        chip.exchange(b);
+    }
+    chip.deselect();
+}
+
+/// `model` at power-on with its sensors on (MPU family: PWR_MGMT_1 = 0x01, awake on the PLL;
+/// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise).
+fn powered(model: ChipModel) -> EmulatedChip {
+    let mut chip = EmulatedChip::new(model, model.who_am_i(), 0x68).expect("the model's identity");
+    match model.family() {
+        Family::Mpu6xxx => spi_write(&mut chip, &[0x6B, 0x01]),
+        Family::Icm42688p => spi_write(&mut chip, &[0x4E, 0x0F]),
+    }
+    chip
+}
+
+/// The first register of the model's data burst.
+fn burst_start(model: ChipModel) -> u8 {
+    match model.family() {
+        Family::Mpu6xxx => 0x3B,   // ACCEL_XOUT_H
+        Family::Icm42688p => 0x1D, // TEMP_DATA1
+    }
+}
+
+/// Times `iters` reads of `mosi` (one transaction each).
+fn timed_bursts(chip: &mut EmulatedChip, mosi: &[u8], iters: u64) -> Duration {
+    let t = Instant::now();
+    for _ in 0..iters {
+        let mut acc = chip.select();
+        for &byte in black_box(mosi) {
+            acc ^= chip.exchange(byte);
+        }
+        chip.deselect();
+        black_box(acc);
+    }
+    t.elapsed()
+}
+
+fn per_chip(c: &mut Criterion) {
+    let s = sample();
+    for model in ChipModel::ALL {
+        if !EmulatedChip::models().any(|m| m == model) {
+            eprintln!(
+                "{}: not emulated by this firmware; only its image conversion is measured",
+                model.name()
+            );
+        }
+    }
+    let mut group = c.benchmark_group("chip image");
+    for model in ChipModel::ALL {
+        let settings = ChipSettings::power_on(model);
+        group.bench_function(BenchmarkId::from_parameter(model.name()), |b| {
+            b.iter(|| black_box(&settings).image(black_box(&s)))
+        });
+    }
+    group.finish();
+
+    let mut group = c.benchmark_group("chip latch_image_at");
+    for model in EmulatedChip::models() {
+        let mut chip = powered(model);
+        let image = chip.settings().image(&s);
+        let period = chip.sample_period_ns();
+        let mut now = 0u64;
+        group.bench_function(BenchmarkId::from_parameter(model.name()), |b| {
+            b.iter(|| {
+                now += period;
+                Chip::latch_image_at(&mut chip, black_box(&image), now);
+            })
+        });
+    }
+    group.finish();
+
+    let mut group = c.benchmark_group("chip latch_at");
+    for model in EmulatedChip::models() {
+        let mut chip = powered(model);
+        let period = chip.sample_period_ns();
+        let mut now = 0u64;
+        group.bench_function(BenchmarkId::from_parameter(model.name()), |b| {
+            b.iter(|| {
+                now += period;
+                Chip::latch_at(&mut chip, black_box(&s), now);
+            })
+        });
+    }
+    group.finish();
+
+    let mut group = c.benchmark_group("chip spi burst");
+    for model in EmulatedChip::models() {
+        let mut chip = powered(model);
+        let period = chip.sample_period_ns();
+        Chip::latch_at(&mut chip, &s, period);
+        let start = burst_start(model);
+        let mut mosi = [0u8; 15];
+        mosi[0] = 0x80 | start;
+        group.throughput(Throughput::Bytes(mosi.len() as u64));
+        group.bench_function(
+            BenchmarkId::new(format!("0x{start:02X} + 14 bytes"), model.name()),
+            |b| b.iter_custom(|iters| timed_bursts(&mut chip, &mosi, iters)),
+        );
+    }
+
+    // The ICM-42688-P's FIFO: stream mode, 20-byte packets (header, accel, gyro, temp 16-bit,
+    // timestamp, 20-bit extension). Each timed chunk reads packets latched before it.
+    let model = ChipModel::Icm42688p;
+    let mut chip = powered(model);
+    spi_write(&mut chip, &[0x16, 0x40]); // FIFO_CONFIG: stream to FIFO
+    spi_write(&mut chip, &[0x5F, 0x17]); // FIFO_CONFIG1: HIRES, TEMP, GYRO, ACCEL
+    let period = chip.sample_period_ns();
+    let mut now = 0u64;
+    // Fewer packets than the 2 KB FIFO holds (102 of 20 bytes): none dropped.
+    const CHUNK: u64 = 64;
+    let mut mosi = [0u8; 21];
+    mosi[0] = 0x80 | 0x30; // FIFO_DATA
+    {
+        // Check once that reads return whole 20-bit packets (header 0x78), back to back. Under
+        // the one-byte-ahead contract of `SpiTarget`, `exchange(mosi[i])` returns the MISO byte
+        // clocked during byte i + 1: the address exchange returns the first data byte.
+        for _ in 0..2 {
+            now += period;
+            Chip::latch_at(&mut chip, &s, now);
+        }
+        for _ in 0..2 {
+            chip.select();
+            let miso: Vec<u8> = mosi.iter().map(|&b| chip.exchange(b)).collect();
+            chip.deselect();
+            assert_eq!(miso[0] & 0xFC, 0x78, "FIFO packet {miso:02x?}");
+        }
+    }
+    group.throughput(Throughput::Bytes(mosi.len() as u64));
+    group.bench_function(
+        BenchmarkId::new("FIFO 0x30 + 20-byte packet", model.name()),
+        |b| {
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                let mut left = iters;
+                while left > 0 {
+                    let n = left.min(CHUNK);
+                    for _ in 0..n {
+                        now += period;
+                        Chip::latch_at(&mut chip, &s, now);
+                    }
+                    total += timed_bursts(&mut chip, &mosi, n);
+                    left -= n;
+                }
+                total
+            })
+        },
+    );
+    group.finish();
+}
+
+criterion_group!(benches, latch, burst, per_chip);
 criterion_main!(benches);

@@ -42,7 +42,14 @@ hard_iron = [0.05, 0.0, -0.02]
 /// A kinematic scene of `seconds` at `rate_hz` with real motion (sines on all six joints, up to
 /// 5 Hz and about 7 rad/s) and the [`SENSORS`]: what the QEMU streaming tests and benches send.
 pub fn motion_scene(rate_hz: u32, seconds: f64, seed: u64) -> Scene {
-    let text = format!(
+    let text = motion_scene_text(rate_hz, seconds, seed);
+    Scene::parse_str(&text, Path::new("qemu-motion.toml"))
+        .unwrap_or_else(|e| panic!("the built-in scene is valid: {e}"))
+}
+
+/// The TOML text of [`motion_scene`], for a test that appends tables of its own (`[chip]`).
+pub fn motion_scene_text(rate_hz: u32, seconds: f64, seed: u64) -> String {
+    format!(
         r#"name = "qemu-motion"
 duration = {seconds}
 rate = {rate_hz}.0
@@ -77,9 +84,7 @@ type = "sine"
 amplitude = 0.2
 frequency = 5.0
 "#
-    ) + SENSORS;
-    Scene::parse_str(&text, Path::new("qemu-motion.toml"))
-        .unwrap_or_else(|e| panic!("the built-in scene is valid: {e}"))
+    ) + SENSORS
 }
 
 #[cfg(test)]
