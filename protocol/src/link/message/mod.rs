@@ -36,18 +36,21 @@
 mod macros;
 mod batch;
 mod configure;
+mod images;
 mod model_terms;
 mod session;
 mod status;
 
 pub use batch::{
-    max_images_per_batch, Bus, Image, ImageBatch, ImageItems, Items, KinematicsBatch,
-    RegisterWrite, RegisterWriteBatch, ServedBatch, ServedSample, WireItem, IMAGE_BATCH_HEADER_LEN,
-    MAX_IMAGE_LEN, MAX_KINEMATICS_PER_BATCH, MAX_REGISTER_WRITES_PER_BATCH, MAX_SERVED_PER_BATCH,
+    Bus, Items, KinematicsBatch, RegisterWrite, RegisterWriteBatch, ServedBatch, ServedSample,
+    WireItem, MAX_KINEMATICS_PER_BATCH, MAX_REGISTER_WRITES_PER_BATCH, MAX_SERVED_PER_BATCH,
     TRUTH_LEN,
 };
 pub use configure::{Configure, ModelParams, Rate, RegisterOverride, Source};
 pub use configure::{MAX_CONFIGURE_LEN, MAX_OVERRIDES};
+pub use images::{
+    max_images_per_batch, Image, ImageBatch, ImageItems, IMAGE_BATCH_HEADER_LEN, MAX_IMAGE_LEN,
+};
 pub use model_terms::{MAX_MARG_CONFIG_LEN, MAX_PERTURBATION_LEN};
 pub use session::{
     Buses, Capabilities, Chips, ErrorCode, ErrorReport, FirmwareVersion, Hello, HelloAck, Modes,
