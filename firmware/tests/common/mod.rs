@@ -12,7 +12,7 @@ pub mod transactions;
 
 pub use transactions::*;
 
-use margemu_firmware::chip::{Config, Mpu6xxx, PhysicalSample, Variant};
+use margemu_firmware::chip::{Config, Mpu6xxx, PhysicalSample, SpiTarget, Variant};
 
 pub const MS: u64 = 1_000_000;
 pub const G: f32 = 9.80665;
@@ -76,11 +76,41 @@ pub fn numbered(k: u64) -> PhysicalSample {
     }
 }
 
+/// What a [`Bench`] needs of the chip on it: an [`Mpu6xxx`], or the same chip behind another
+/// bus path (the SPI shadow's measuring rig).
+pub trait BenchChip: SpiTarget {
+    /// Nanoseconds between samples under the chip's current rate registers.
+    fn sample_period_ns(&self) -> u64;
+    /// Whether the chip's clock runs (it takes samples).
+    fn is_running(&self) -> bool;
+    /// Latches `sample` taken at `now_ns`.
+    fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64);
+    /// Moves the chip's clock to `now_ns`.
+    fn advance(&mut self, now_ns: u64);
+    /// The driver's initialisation is over ([`fc::Board::loop_starts`]).
+    fn loop_starts(&mut self) {}
+}
+
+impl BenchChip for Mpu6xxx {
+    fn sample_period_ns(&self) -> u64 {
+        Mpu6xxx::sample_period_ns(self)
+    }
+    fn is_running(&self) -> bool {
+        Mpu6xxx::is_running(self)
+    }
+    fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64) {
+        Mpu6xxx::latch_at(self, sample, now_ns);
+    }
+    fn advance(&mut self, now_ns: u64) {
+        Mpu6xxx::advance(self, now_ns);
+    }
+}
+
 /// A chip on a bench: it latches [`numbered`] samples at the instants of its own output clock
 /// (multiples of [`Mpu6xxx::sample_period_ns`], re-read after every latch and transaction) while
 /// the flight-controller code waits, and serves SPI transactions in zero time in between.
-pub struct Bench {
-    pub chip: Mpu6xxx,
+pub struct Bench<C = Mpu6xxx> {
+    pub chip: C,
     now_ns: u64,
     last_latch_ns: u64,
     /// Instant of every latch, by sample number (sample `k` latched at `instants[k]`).
@@ -89,8 +119,8 @@ pub struct Bench {
     pub running: Vec<bool>,
 }
 
-impl Bench {
-    pub fn new(chip: Mpu6xxx) -> Self {
+impl<C: BenchChip> Bench<C> {
+    pub fn new(chip: C) -> Self {
         Self {
             chip,
             now_ns: 0,
@@ -160,7 +190,7 @@ impl Bench {
     }
 }
 
-impl Bench {
+impl<C> Bench<C> {
     /// Whether sample `k` carries a new accel value (the rule of `regmap::mpu6xxx::rates`,
     /// restated): it is the first the chip took after sleeping, or `instant / accel_period`
     /// differs from sample `k − 1`'s. (Valid while no reset happens between the two.)

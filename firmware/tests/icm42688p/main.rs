@@ -12,6 +12,7 @@ mod data;
 mod fc;
 mod fc_ardupilot;
 mod fc_betaflight;
+mod fc_decoding;
 mod fc_px4;
 mod fifo;
 mod interrupts;
@@ -23,13 +24,13 @@ mod random_ops;
 #[path = "../common/transactions.rs"]
 mod transactions;
 
+pub use fc::sample;
 pub use transactions::*;
 
 use margemu_firmware::chip::{I2cTarget, Icm42688p, PhysicalSample, SpiTarget};
 
 pub const MS: u64 = 1_000_000;
 pub const US: u64 = 1_000;
-pub const G: f32 = 9.80665;
 
 /// A fresh ICM-42688-P.
 pub fn chip() -> Icm42688p {
@@ -46,17 +47,4 @@ pub fn running() -> Icm42688p {
 /// Selects a register bank (REG_BANK_SEL 0x76).
 pub fn bank(chip: &mut impl SpiTarget, bank: u8) {
     spi_write(chip, 0x76, &[bank]);
-}
-
-/// A sample whose register values at ±16 g / ±2000 °/s are small integers: accel x = `n` LSB,
-/// y = −2n, z = 1 g (2048); gyro x = n (at 16.4 LSB/(°/s)), y = 3, z = −n; 25 °C.
-pub fn sample(n: i16) -> PhysicalSample {
-    let n = f32::from(n);
-    let dps = core::f32::consts::PI / 180.0;
-    PhysicalSample {
-        acc: [n * G / 2048.0, -2.0 * n * G / 2048.0, G],
-        gyr: [n / 16.4 * dps, 3.0 / 16.4 * dps, -n / 16.4 * dps],
-        mag: [0.0; 3],
-        temp_c: 25.0,
-    }
 }
