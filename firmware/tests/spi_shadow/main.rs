@@ -17,8 +17,9 @@
 //! file, included with `#[path]`, over that crate's rig trait implemented for [`Shadowed`]:
 //! `icm42688p.rs` (the ICM-42688-P sequences of `tests/icm42688p/fc_*.rs` and their `Rig`) and
 //! `fc_6xxx.rs` (the MPU-6000 and ICM-20602 sequences of `tests/common/fc.rs` on its `Bench`).
-//! Those mark the loop's start (`loop_starts`) and run the loop at the sample clock: the
-//! drivers switch to it there.
+//! Those mark the loop's start (`loop_starts`) and run the loop at the sample clock, as the
+//! drivers switch to it there (ArduPilot's register checks on the ICM-42688-P go back to the
+//! low clock for the read, as the driver does: `set_fast`).
 
 #[path = "../common/mod.rs"]
 mod common;
