@@ -33,6 +33,7 @@ mod ak8963;
 mod emulated;
 pub mod icm42688p;
 pub mod mpu6xxx;
+mod spi_phase;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};

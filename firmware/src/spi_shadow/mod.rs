@@ -70,8 +70,11 @@ pub use verify::{replay, Outcome, Speculator, Stats, MAX_CONFIDENCE, SUCCESSORS,
 use crate::chip::Chip;
 
 /// MISO bytes the preloaded stream covers, and MOSI bytes a [`Capture`] keeps: the address
-/// byte and 128 data bytes (every register once).
-pub const STREAM_LEN: usize = 1 + 128;
+/// byte and 256 data bytes (every register twice; the longest FIFO bursts of the drivers
+/// measured: PX4's 8 high-resolution ICM-42688-P packets behind INT_STATUS and the count are
+/// 163 bytes, its ICM-20602 transfers 3 + 14 × 9 and more). A longer transaction is truncated:
+/// the bytes beyond are neither served nor replayed.
+pub const STREAM_LEN: usize = 1 + 256;
 
 /// MISO during the address byte (what the chip models send there).
 pub const ADDRESS_PHASE_MISO: u8 = 0x00;

@@ -17,7 +17,7 @@ use super::{replay, serve, Capture, Outcome, Shadow, Speculator, SpiPort, Stats,
 pub const UNDERRUN: u8 = 0xEE;
 
 /// Longest transaction [`SimPort`] clocks; later bytes are not clocked.
-pub const SIM_LEN: usize = 256;
+pub const SIM_LEN: usize = 512;
 
 /// Bus timing of the simulated controller, in ticks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,7 +1,7 @@
 use margemu_protocol::regmap::mpu6xxx::image::IMAGE_LEN;
 use margemu_protocol::regmap::mpu6xxx::{is_read_only, reg};
 
-use super::sim::{SimPort, Timing, FAST, SLOW, UNDERRUN};
+use super::sim::{SimPort, Timing, FAST, SIM_LEN, SLOW, UNDERRUN};
 use super::*;
 use crate::chip::{Chip, EmulatedChip, SpiTarget};
 
@@ -19,9 +19,9 @@ fn chip_with_sample() -> EmulatedChip {
 
 /// What the chip itself puts on MISO for `mosi` (one byte ahead, as `SpiTarget` specifies),
 /// on a copy so the chip is left as it was.
-fn reference(chip: &EmulatedChip, mosi: &[u8]) -> [u8; 256] {
+fn reference(chip: &EmulatedChip, mosi: &[u8]) -> [u8; SIM_LEN] {
     let mut chip = chip.clone();
-    let mut miso = [0; 256];
+    let mut miso = [0; SIM_LEN];
     let mut next = chip.select();
     for (slot, &m) in miso.iter_mut().zip(mosi) {
         *slot = next;
@@ -33,7 +33,7 @@ fn reference(chip: &EmulatedChip, mosi: &[u8]) -> [u8; 256] {
 
 /// Serves `mosi` through the simulated port from `shadow`; returns the capture and the MISO the
 /// controller saw, and checks the capture records exactly what was sent.
-fn transact(timing: Timing, shadow: &mut Shadow, mosi: &[u8]) -> (Capture, [u8; 256]) {
+fn transact(timing: Timing, shadow: &mut Shadow, mosi: &[u8]) -> (Capture, [u8; SIM_LEN]) {
     let mut port = SimPort::new(timing, mosi, shadow.stream());
     let mut capture = Capture::new();
     serve(&mut port, shadow, &mut capture);
@@ -374,7 +374,7 @@ fn sim_port_overlong_and_empty_transactions() {
     let mut chip = chip_with_sample();
     let mut shadow = Shadow::new();
     shadow.capture(&chip, DEFAULT_START, 0);
-    let mut long = [0u8; 200];
+    let mut long = [0u8; STREAM_LEN + 50];
     long[0] = READ | DEFAULT_START;
     let (capture, _) = transact(FAST, &mut shadow, &long);
     assert!(capture.truncated());
@@ -409,6 +409,52 @@ fn speculator_tells_an_empty_count_from_a_full_one() {
         right,
         [false, false, false, false, true, true, true, true, true, true]
     );
+}
+
+#[test]
+fn speculator_tells_reads_apart_by_length() {
+    // A driver that got a wrong count reads far too much, then re-reads TEMP_OUT and resets
+    // its FIFO; its normal polls read one record and go on with the next count. Keyed by the
+    // start alone, the two successors of the FIFO read alternate and the recovery's wins half
+    // the time, so the next count is missed, the driver gets a wrong count again, and so on.
+    let mut s = Speculator::new();
+    let read = |start: u8, len: usize| {
+        let mosi = [READ | start; 200];
+        Capture::from_bytes(&mosi[..len], &[0x5A; 200][..len], 0, None)
+    };
+    let (count, record, long, temp) = (
+        read(reg::FIFO_COUNTH, 3),
+        read(reg::FIFO_R_W, 15),
+        read(reg::FIFO_R_W, 200),
+        read(reg::TEMP_OUT_H, 3),
+    );
+    let polls = [
+        &count, &long, &temp, &count, &record, &count, &record, &count,
+    ];
+    let mut right = [false; 8];
+    for (r, capture) in right.iter_mut().zip(polls) {
+        *r = s.predict(DEFAULT_START) == capture.mosi()[0] & 0x7F;
+        s.observe(capture);
+    }
+    assert_eq!(right, [false, false, false, false, true, false, true, true]);
+}
+
+#[test]
+fn speculator_tells_writes_apart_by_the_value_written() {
+    // A bank select written before the sensor burst (bank 0) and before a bank-1 check.
+    let mut s = Speculator::new();
+    let bank = |b: u8| Capture::from_bytes(&[0x76, b], &[0, 0], 0, None);
+    let burst = Capture::from_bytes(&[READ | 0x2D, 0, 0, 0], &[0, 1, 2, 3], 0, None);
+    let check = Capture::from_bytes(&[READ | 0x0C, 0], &[0, 6], 0, None);
+    let sequence = [&bank(1), &check, &bank(0), &burst];
+    for capture in sequence.iter().chain(&sequence) {
+        s.observe(capture);
+    }
+    s.observe(&bank(1));
+    assert_eq!(s.predict(DEFAULT_START), 0x0C);
+    s.observe(&check);
+    s.observe(&bank(0));
+    assert_eq!(s.predict(DEFAULT_START), 0x2D);
 }
 
 /// A chip with two register banks, for the shadow's sake only: REG_BANK_SEL at 0x76 in both

@@ -132,21 +132,31 @@ pub const SUCCESSORS: usize = 16;
 /// plus one consecutive transactions that followed otherwise.
 pub const MAX_CONFIDENCE: u8 = 2;
 
-/// What the speculator knows of a transaction: its first MOSI byte (`R/W̄ | address`), and
-/// for a read whether every data byte the controller got was zero (drivers branch on that: an
-/// empty FIFO count, a clear status).
+/// What the speculator knows of a transaction: its first MOSI byte (`R/W̄ | address`), its
+/// length (as stored: a truncated one counts as [`STREAM_LEN`](super::STREAM_LEN)), and a
+/// byte of its data: for a write the first byte written (a bank select's bank), for a read
+/// whether every data byte the controller got was zero (1 if so; drivers branch on that: an
+/// empty FIFO count, a clear status). The length tells a driver's reads apart that start at
+/// the same register but mean different things: a FIFO read of one record, followed by the
+/// next poll, and the long read of a driver that got a wrong count, followed by its recovery.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Key {
     first: u8,
-    zero: bool,
+    len: u16,
+    data: u8,
 }
 
 impl Key {
     fn of(capture: &Capture) -> Option<Self> {
-        let (&first, _) = capture.mosi().split_first()?;
-        let data = capture.sent().get(1..).unwrap_or(&[]);
-        let zero = first & 0x80 != 0 && data.iter().all(|&b| b == 0);
-        Some(Self { first, zero })
+        let (&first, written) = capture.mosi().split_first()?;
+        let data = if first & 0x80 == 0 {
+            written.first().copied().unwrap_or(0)
+        } else {
+            let sent = capture.sent().get(1..).unwrap_or(&[]);
+            u8::from(sent.iter().all(|&b| b == 0))
+        };
+        let len = u16::try_from(capture.mosi().len()).unwrap_or(u16::MAX);
+        Some(Self { first, len, data })
     }
 }
 
@@ -167,9 +177,10 @@ struct Successor {
 /// Flight-controller drivers repeat fixed transactions: a burst from one register on every
 /// data-ready, or a pair (FIFO count, then FIFO data), with writes and single-register checks
 /// in between. The speculator remembers, for each of the [`SUCCESSORS`] transactions seen
-/// last (keyed by their first MOSI byte: read or write, and address; and for reads whether the
-/// controller got only zeros, since a driver reads FIFO data only when the count it read is not
-/// zero), the start address of the read that followed, with a small confidence so that one odd transaction does not unlearn a
+/// last (keyed by their first MOSI byte: read or write, and address; their length; for writes
+/// the first byte written, and for reads whether the controller got only zeros, since a driver
+/// reads FIFO data only when the count it read is not zero), the start address of the read
+/// that followed, with a small confidence so that one odd transaction does not unlearn a
 /// pattern: a remembered successor is replaced only after it was wrong
 /// [`MAX_CONFIDENCE`] + 1 times more than right. The least recently used entry makes room for a
 /// new one. Without an entry for the last transaction, the prediction falls back to where
@@ -202,7 +213,8 @@ impl Speculator {
             table: [Successor {
                 key: Key {
                     first: 0,
-                    zero: false,
+                    len: 0,
+                    data: 0,
                 },
                 next: 0,
                 confidence: 0,

@@ -42,6 +42,9 @@ pub trait Board {
     fn wait_ns(&mut self, ns: u64);
     /// Waits for the next data-ready edge.
     fn wait_data_ready(&mut self);
+    /// The driver's initialisation is over: its sampling loop starts (a board measuring the
+    /// bus counts from here, at the driver's sample clock).
+    fn loop_starts(&mut self) {}
 }
 
 /// One decoded record: ACCEL_XOUT, ACCEL_ZOUT, TEMP_OUT, GYRO_XOUT.
@@ -143,7 +146,7 @@ pub fn fc_betaflight<B: Board>(board: &mut B, samples: usize) -> Result<FcRun, F
         board.wait_ns(15_000);
     }
     write(board, 0x1A, 0x00); // DLPF_CFG 0: 8 kHz
-                              // Run: one 14-byte burst per data-ready edge.
+    board.loop_starts(); // Run: one 14-byte burst per data-ready edge.
     let mut run = FcRun::default();
     let mut burst = [0u8; 15];
     burst[0] = 0x80 | 0x3B;
@@ -216,6 +219,7 @@ pub fn fc_ardupilot<B: Board>(
     let pin_cfg = (read(board, 0x37, 1)[0] | 0x30) & 0x02; // as the driver computes it
     write(board, 0x37, pin_cfg);
     // _read_fifo every 1 ms
+    board.loop_starts();
     let mut run = FcRun::default();
     let mut cached_temp: i16 = 0;
     for poll in 0..polls {
@@ -302,6 +306,7 @@ pub fn px4_icm20602<B: Board>(board: &mut B, polls: usize) -> Result<FcRun, FcEr
             return Err(FcError::ReadBack(reg, back));
         }
     }
+    board.loop_starts();
     let mut run = FcRun::default();
     for _ in 0..polls {
         board.wait_ns(1_000_000);
@@ -334,10 +339,10 @@ pub fn px4_accel_pattern_ok(fifo: &[u8], samples: usize) -> bool {
     (accel(0) == accel(1) && accel(2) == accel(3)) || accel(1) == accel(2)
 }
 
-impl Board for super::Bench {
-    type Chip = margemu_firmware::chip::Mpu6xxx;
+impl<C: super::BenchChip> Board for super::Bench<C> {
+    type Chip = C;
 
-    fn chip(&mut self) -> &mut Self::Chip {
+    fn chip(&mut self) -> &mut C {
         &mut self.chip
     }
 
@@ -347,5 +352,9 @@ impl Board for super::Bench {
 
     fn wait_data_ready(&mut self) {
         super::Bench::wait_data_ready(self);
+    }
+
+    fn loop_starts(&mut self) {
+        self.chip.loop_starts();
     }
 }

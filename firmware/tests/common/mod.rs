@@ -8,8 +8,11 @@
 #![allow(dead_code)]
 
 pub mod fc;
+pub mod transactions;
 
-use margemu_firmware::chip::{Config, I2cTarget, Mpu6xxx, PhysicalSample, SpiTarget, Variant};
+pub use transactions::*;
+
+use margemu_firmware::chip::{Config, Mpu6xxx, PhysicalSample, SpiTarget, Variant};
 
 pub const MS: u64 = 1_000_000;
 pub const G: f32 = 9.80665;
@@ -22,62 +25,35 @@ pub fn chip(variant: Variant) -> Mpu6xxx {
     })
 }
 
-/// One SPI transaction: MOSI bytes in, MISO bytes out, aligned byte for byte.
-pub fn spi(chip: &mut impl SpiTarget, mosi: &[u8]) -> Vec<u8> {
-    let mut miso = vec![chip.select()];
-    for (i, &byte) in mosi.iter().enumerate() {
-        let next = chip.exchange(byte);
-        if i + 1 < mosi.len() {
-            miso.push(next);
-        }
-    }
-    chip.deselect();
-    miso.truncate(mosi.len());
-    miso
-}
-
-/// Reads `n` registers from `addr` over SPI.
-pub fn spi_read(chip: &mut impl SpiTarget, addr: u8, n: usize) -> Vec<u8> {
-    let mut mosi = vec![0x80 | addr];
-    mosi.resize(n + 1, 0x00);
-    spi(chip, &mosi)[1..].to_vec()
-}
-
-/// Writes `values` from `addr` on over SPI.
-pub fn spi_write(chip: &mut impl SpiTarget, addr: u8, values: &[u8]) {
-    let mut mosi = vec![addr];
-    mosi.extend_from_slice(values);
-    assert_eq!(
-        spi(chip, &mosi),
-        vec![0; mosi.len()],
-        "MISO is 0x00 during writes"
-    );
-}
-
-/// An I2C write transaction; returns the ACK of the address and each byte.
-pub fn i2c_write(chip: &mut impl I2cTarget, address: u8, bytes: &[u8]) -> Vec<bool> {
-    let mut acks = vec![chip.start(address, false)];
-    acks.extend(bytes.iter().map(|&b| chip.write(b)));
-    chip.stop();
-    acks
-}
-
-/// Register read over I2C; `None` if the address was not acknowledged.
-pub fn i2c_read(chip: &mut impl I2cTarget, address: u8, reg: u8, n: usize) -> Option<Vec<u8>> {
-    if !chip.start(address, false) {
-        chip.stop();
-        return None;
-    }
-    chip.write(reg);
-    assert!(chip.start(address, true), "repeated START");
-    let bytes = (0..n).map(|_| chip.read()).collect();
-    chip.stop();
-    Some(bytes)
-}
-
 /// Every register as the bus would read it, without side effects.
 pub fn registers(chip: &Mpu6xxx) -> Vec<u8> {
     (0..0x80).map(|a| chip.peek(a)).collect()
+}
+
+/// Checks every register against `expected(addr)`, as the bus reads it without side effects.
+pub fn assert_registers(chip: &Mpu6xxx, expected: impl Fn(usize) -> u8) {
+    for (addr, value) in registers(chip).into_iter().enumerate() {
+        assert_eq!(value, expected(addr), "register {addr:#04x}");
+    }
+}
+
+/// Writes `value` to each of `addrs` (registers the variant lacks): each still reads 0x00.
+pub fn assert_writes_ignored(chip: &mut Mpu6xxx, addrs: &[u8], value: u8) {
+    for &addr in addrs {
+        spi_write(chip, addr, &[value]);
+        assert_eq!(spi_read(chip, addr, 1), [0x00], "register {addr:#04x}");
+    }
+}
+
+/// Latches [`numbered`]`(0)` at each temperature in turn, 1 ms apart, and checks TEMP_OUT
+/// against its raw value.
+pub fn assert_temperature_scale(chip: &mut Mpu6xxx, points: [(f32, i16); 3]) {
+    for (k, (t, raw)) in points.into_iter().enumerate() {
+        let mut s = numbered(0);
+        s.temp_c = t;
+        chip.latch_at(&s, (k as u64 + 1) * MS);
+        assert_eq!(spi_read(chip, 0x41, 2), raw.to_be_bytes(), "{t} °C");
+    }
 }
 
 /// Big-endian i16 at `bytes[i..i + 2]`.
@@ -100,11 +76,41 @@ pub fn numbered(k: u64) -> PhysicalSample {
     }
 }
 
+/// What a [`Bench`] needs of the chip on it: an [`Mpu6xxx`], or the same chip behind another
+/// bus path (the SPI shadow's measuring rig).
+pub trait BenchChip: SpiTarget {
+    /// Nanoseconds between samples under the chip's current rate registers.
+    fn sample_period_ns(&self) -> u64;
+    /// Whether the chip's clock runs (it takes samples).
+    fn is_running(&self) -> bool;
+    /// Latches `sample` taken at `now_ns`.
+    fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64);
+    /// Moves the chip's clock to `now_ns`.
+    fn advance(&mut self, now_ns: u64);
+    /// The driver's initialisation is over ([`fc::Board::loop_starts`]).
+    fn loop_starts(&mut self) {}
+}
+
+impl BenchChip for Mpu6xxx {
+    fn sample_period_ns(&self) -> u64 {
+        Mpu6xxx::sample_period_ns(self)
+    }
+    fn is_running(&self) -> bool {
+        Mpu6xxx::is_running(self)
+    }
+    fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64) {
+        Mpu6xxx::latch_at(self, sample, now_ns);
+    }
+    fn advance(&mut self, now_ns: u64) {
+        Mpu6xxx::advance(self, now_ns);
+    }
+}
+
 /// A chip on a bench: it latches [`numbered`] samples at the instants of its own output clock
 /// (multiples of [`Mpu6xxx::sample_period_ns`], re-read after every latch and transaction) while
 /// the flight-controller code waits, and serves SPI transactions in zero time in between.
-pub struct Bench {
-    pub chip: Mpu6xxx,
+pub struct Bench<C = Mpu6xxx> {
+    pub chip: C,
     now_ns: u64,
     last_latch_ns: u64,
     /// Instant of every latch, by sample number (sample `k` latched at `instants[k]`).
@@ -113,8 +119,8 @@ pub struct Bench {
     pub running: Vec<bool>,
 }
 
-impl Bench {
-    pub fn new(chip: Mpu6xxx) -> Self {
+impl<C: BenchChip> Bench<C> {
+    pub fn new(chip: C) -> Self {
         Self {
             chip,
             now_ns: 0,
@@ -184,7 +190,7 @@ impl Bench {
     }
 }
 
-impl Bench {
+impl<C> Bench<C> {
     /// Whether sample `k` carries a new accel value (the rule of `regmap::mpu6xxx::rates`,
     /// restated): it is the first the chip took after sleeping, or `instant / accel_period`
     /// differs from sample `k − 1`'s. (Valid while no reset happens between the two.)

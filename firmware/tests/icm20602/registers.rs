@@ -13,23 +13,20 @@ fn identity_and_reset_values() {
         ..Config::default()
     });
     assert!(c.ak8963().is_none());
-    for (addr, value) in registers(&c).into_iter().enumerate() {
-        let expected = match addr {
-            0x0D..=0x0F => addr as u8 - 0x0D + 4, // SELF_TEST_X/Y/Z_ACCEL
-            0x1A => 0x80,                         // CONFIG
-            0x50..=0x52 => addr as u8 - 0x50 + 1, // SELF_TEST_X/Y/Z_GYRO
-            0x6B => 0x41,                         // asleep, CLKSEL 1
-            0x75 => 0x12,
-            0x77 => 0x12,
-            0x78 => 0x34,
-            0x7A => 0x56,
-            0x7B => 0x78,
-            0x7D => 0x9A,
-            0x7E => 0xBC,
-            _ => 0x00,
-        };
-        assert_eq!(value, expected, "register {addr:#04x}");
-    }
+    assert_registers(&c, |addr| match addr {
+        0x0D..=0x0F => addr as u8 - 0x0D + 4, // SELF_TEST_X/Y/Z_ACCEL
+        0x1A => 0x80,                         // CONFIG
+        0x50..=0x52 => addr as u8 - 0x50 + 1, // SELF_TEST_X/Y/Z_GYRO
+        0x6B => 0x41,                         // asleep, CLKSEL 1
+        0x75 => 0x12,
+        0x77 => 0x12,
+        0x78 => 0x34,
+        0x7A => 0x56,
+        0x7B => 0x78,
+        0x7D => 0x9A,
+        0x7E => 0xBC,
+        _ => 0x00,
+    });
 }
 
 #[test]
@@ -47,12 +44,10 @@ fn clock_read_back_and_reset() {
 fn no_auxiliary_master_ext_sens_data_or_dmp() {
     let mut c = awake();
     // I2C_MST_CTRL, slave 0, slave 4, I2C_SLV0_DO, I2C_MST_DELAY_CTRL, BANK_SEL..MEM_R_W.
-    for addr in [
+    let absent = [
         0x24, 0x25, 0x27, 0x31, 0x34, 0x63, 0x67, 0x6D, 0x6E, 0x6F, 0x00, 0x0C,
-    ] {
-        spi_write(&mut c, addr, &[0x8C]);
-        assert_eq!(spi_read(&mut c, addr, 1), [0x00], "register {addr:#04x}");
-    }
+    ];
+    assert_writes_ignored(&mut c, &absent, 0x8C);
     spi_write(&mut c, 0x6A, &[0x20]); // I2C_MST_EN: reserved here, nothing starts
     c.latch_at(&numbered(3), MS);
     assert_eq!(spi_read(&mut c, 0x49, 7), [0; 7], "no EXT_SENS_DATA");
@@ -118,13 +113,5 @@ fn signal_path_and_user_ctrl_resets() {
 fn temperature_scale() {
     // TEMP_OUT / 326.8 + 25 °C: 25 °C → 0, 35 °C → 3268, 0 °C → −8170.
     let mut c = awake();
-    for (k, (t, raw)) in [(25.0f32, 0i16), (35.0, 3268), (0.0, -8170)]
-        .into_iter()
-        .enumerate()
-    {
-        let mut s = numbered(0);
-        s.temp_c = t;
-        c.latch_at(&s, (k as u64 + 1) * MS);
-        assert_eq!(spi_read(&mut c, 0x41, 2), raw.to_be_bytes(), "{t} °C");
-    }
+    assert_temperature_scale(&mut c, [(25.0f32, 0i16), (35.0, 3268), (0.0, -8170)]);
 }

@@ -6,6 +6,9 @@
 use margemu_firmware::chip::{Icm42688p, PhysicalSample, SpiTarget};
 use margemu_protocol::regmap::icm42688p::image::{ImageConfig, ImageRepr};
 
+/// Standard gravity, m/s².
+const G: f32 = 9.80665;
+
 /// What a sequence needs of the device under test besides SPI: sample injection and INT1.
 pub trait Rig: SpiTarget {
     /// Latches `sample` taken at `now_ns`.
@@ -14,6 +17,12 @@ pub trait Rig: SpiTarget {
     fn int1(&self, now_ns: u64) -> bool;
     /// The conversion settings of the chip right now.
     fn image_config(&self) -> ImageConfig;
+    /// The driver's initialisation is over: its sampling loop starts (a rig measuring the bus
+    /// counts from here, at the driver's sample clock).
+    fn loop_starts(&mut self) {}
+    /// The driver's SPI clock from the next transaction on: its sample clock (`true`, from
+    /// [`Rig::loop_starts`] on) or its low register clock (`false`).
+    fn set_fast(&mut self, _fast: bool) {}
 }
 
 impl Rig for Icm42688p {
@@ -25,6 +34,19 @@ impl Rig for Icm42688p {
     }
     fn image_config(&self) -> ImageConfig {
         Icm42688p::image_config(self)
+    }
+}
+
+/// A sample whose register values at ±16 g / ±2000 °/s are small integers: accel x = `n` LSB,
+/// y = −2n, z = 1 g (2048); gyro x = n (at 16.4 LSB/(°/s)), y = 3, z = −n; 25 °C.
+pub fn sample(n: i16) -> PhysicalSample {
+    let n = f32::from(n);
+    let dps = core::f32::consts::PI / 180.0;
+    PhysicalSample {
+        acc: [n * G / 2048.0, -2.0 * n * G / 2048.0, G],
+        gyr: [n / 16.4 * dps, 3.0 / 16.4 * dps, -n / 16.4 * dps],
+        mag: [0.0; 3],
+        temp_c: 25.0,
     }
 }
 
@@ -98,7 +120,7 @@ impl<'a, R: Rig> Recorder<'a, R> {
     /// Latches sample `k` at `now_ns` and records what a driver should decode from it:
     /// `shift` = (accel, gyro) right shifts of the 20-bit values, or `None` for 16-bit data.
     pub fn latch(&mut self, k: i16, now_ns: u64, shift: Option<(u32, u32)>) {
-        let s = super::sample(k);
+        let s = sample(k);
         let repr = ImageRepr::from_physical(s.acc, s.gyr, s.temp_c, &self.rig.image_config());
         self.rig.latch(&s, now_ns);
         self.run.expected.push(match shift {

@@ -6,21 +6,7 @@ use super::*;
 use margemu_firmware::chip::icm42688p::Config;
 use proptest::prelude::*;
 
-#[derive(Clone, Debug)]
-enum Op {
-    Select,
-    Exchange(u8),
-    Deselect,
-    /// A whole SPI transaction of random bytes.
-    Spi(Vec<u8>),
-    Start(u8, bool),
-    Write(u8),
-    Read,
-    Stop,
-    Latch(PhysicalSample, u32),
-    LatchImage([u8; 32], u32),
-    Advance(u32),
-}
+type Op = random_ops::Op<32>;
 
 /// Register bytes biased towards the registers and values with behaviour.
 fn mosi() -> impl Strategy<Value = u8> {
@@ -76,50 +62,14 @@ fn op() -> impl Strategy<Value = Op> {
 }
 
 fn run(c: &mut Icm42688p, ops: &[Op]) -> u64 {
-    let mut now = 0u64;
-    for op in ops {
-        match op {
-            Op::Select => {
-                c.select();
-            }
-            Op::Exchange(b) => {
-                c.exchange(*b);
-            }
-            Op::Deselect => c.deselect(),
-            Op::Spi(bytes) => {
-                spi(c, bytes);
-            }
-            Op::Start(a, r) => {
-                c.start(*a, *r);
-            }
-            Op::Write(b) => {
-                c.write(*b);
-            }
-            Op::Read => {
-                c.read();
-            }
-            Op::Stop => c.stop(),
-            Op::Latch(s, dt) => {
-                now += u64::from(*dt);
-                c.latch_at(s, now);
-            }
-            Op::LatchImage(i, dt) => {
-                now += u64::from(*dt);
-                c.latch_image_at(i, now);
-            }
-            Op::Advance(dt) => {
-                now += u64::from(*dt);
-                c.advance(now);
-            }
-        }
+    random_ops::run(c, ops, |c, now| {
         let _ = (
             c.int_pin(),
             c.int2_pin_at(now),
             c.output_rate_hz(),
             c.int_pulse_end_ns(),
         );
-    }
-    now
+    })
 }
 
 /// Every register of banks 0–4 as the bus would read it.

@@ -12,22 +12,19 @@ fn reset_values_with_the_factory_trim() {
         accel_offset: [0x1234, 0x5678, 0x9ABC],
         ..Config::default()
     });
-    for (addr, value) in registers(&c).into_iter().enumerate() {
-        let expected = match addr {
-            0x06 => 0x12, // XA_OFFS_H
-            0x07 => 0x34,
-            0x08 => 0x56,
-            0x09 => 0x78,
-            0x0A => 0x9A,
-            0x0B => 0xBC,
-            0x0C => 0x58,                     // PRODUCT_ID
-            0x0D..=0x10 => addr as u8 - 0x0C, // SELF_TEST_X/Y/Z/A
-            0x6B => 0x40,                     // asleep, internal oscillator
-            0x75 => 0x68,
-            _ => 0x00,
-        };
-        assert_eq!(value, expected, "register {addr:#04x}");
-    }
+    assert_registers(&c, |addr| match addr {
+        0x06 => 0x12, // XA_OFFS_H
+        0x07 => 0x34,
+        0x08 => 0x56,
+        0x09 => 0x78,
+        0x0A => 0x9A,
+        0x0B => 0xBC,
+        0x0C => 0x58,                     // PRODUCT_ID
+        0x0D..=0x10 => addr as u8 - 0x0C, // SELF_TEST_X/Y/Z/A
+        0x6B => 0x40,                     // asleep, internal oscillator
+        0x75 => 0x68,
+        _ => 0x00,
+    });
 }
 
 #[test]
@@ -35,10 +32,8 @@ fn missing_registers_read_zero_and_ignore_writes() {
     let mut c = awake();
     // ACCEL_CONFIG2, LP_ACCEL_ODR (MPU-6500 and later), I2C_IF (ICM-20602), the MPU-6500's
     // accel offsets 0x77.., the reserved top.
-    for addr in [0x1D, 0x1E, 0x70, 0x71, 0x76, 0x77, 0x78, 0x7A, 0x7D, 0x7F] {
-        spi_write(&mut c, addr, &[0xA5]);
-        assert_eq!(spi_read(&mut c, addr, 1), [0x00], "register {addr:#04x}");
-    }
+    let absent = [0x1D, 0x1E, 0x70, 0x71, 0x76, 0x77, 0x78, 0x7A, 0x7D, 0x7F];
+    assert_writes_ignored(&mut c, &absent, 0xA5);
     // A burst crosses them: 0x1C, 0x1D (gone), 0x1E (gone), 0x1F.
     spi_write(&mut c, 0x1C, &[0x18, 0x08, 0x01, 0x22]);
     assert_eq!(spi_read(&mut c, 0x1C, 4), [0x18, 0x00, 0x00, 0x22]);
@@ -118,13 +113,5 @@ fn temperature_scale() {
     // TEMP_OUT / 340 + 36.53 °C (RM section 4.18): 36.53 °C → 0, 46.53 °C → 3400,
     // 25 °C → −3920.2 → −3920.
     let mut c = awake();
-    for (k, (t, raw)) in [(36.53f32, 0i16), (46.53, 3400), (25.0, -3920)]
-        .into_iter()
-        .enumerate()
-    {
-        let mut s = numbered(0);
-        s.temp_c = t;
-        c.latch_at(&s, (k as u64 + 1) * MS);
-        assert_eq!(spi_read(&mut c, 0x41, 2), raw.to_be_bytes(), "{t} °C");
-    }
+    assert_temperature_scale(&mut c, [(36.53f32, 0i16), (46.53, 3400), (25.0, -3920)]);
 }

@@ -6,21 +6,7 @@ use super::*;
 use margemu_firmware::chip::Variant;
 use proptest::prelude::*;
 
-#[derive(Clone, Debug)]
-enum Op {
-    Select,
-    Exchange(u8),
-    Deselect,
-    /// A whole SPI transaction of random bytes.
-    Spi(Vec<u8>),
-    Start(u8, bool),
-    Write(u8),
-    Read,
-    Stop,
-    Latch(PhysicalSample, u32),
-    LatchImage([u8; 22], u32),
-    Advance(u32),
-}
+type Op = random_ops::Op<22>;
 
 /// Addresses around the interesting ones, so random I2C traffic actually reaches the chips.
 fn i2c_address() -> impl Strategy<Value = u8> {
@@ -91,50 +77,14 @@ fn variant() -> impl Strategy<Value = Variant> {
 }
 
 fn run(c: &mut Mpu6xxx, ops: &[Op]) -> u64 {
-    let mut now = 0u64;
-    for op in ops {
-        match op {
-            Op::Select => {
-                c.select();
-            }
-            Op::Exchange(b) => {
-                c.exchange(*b);
-            }
-            Op::Deselect => c.deselect(),
-            Op::Spi(bytes) => {
-                spi(c, bytes);
-            }
-            Op::Start(a, r) => {
-                c.start(*a, *r);
-            }
-            Op::Write(b) => {
-                c.write(*b);
-            }
-            Op::Read => {
-                c.read();
-            }
-            Op::Stop => c.stop(),
-            Op::Latch(s, dt) => {
-                now += u64::from(*dt);
-                c.latch_at(s, now);
-            }
-            Op::LatchImage(i, dt) => {
-                now += u64::from(*dt);
-                c.latch_image_at(i, now);
-            }
-            Op::Advance(dt) => {
-                now += u64::from(*dt);
-                c.advance(now);
-            }
-        }
+    random_ops::run(c, ops, |c, _| {
         let _ = (
             c.int_pin(),
             c.peek(0x3A),
             c.output_rate_hz(),
             c.int_pulse_end_ns(),
         );
-    }
-    now
+    })
 }
 
 fn ak_registers(c: &Mpu6xxx) -> Vec<u8> {

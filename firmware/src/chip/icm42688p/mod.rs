@@ -61,10 +61,10 @@ use margemu_protocol::regmap::icm42688p::{bank0, bits, AccelFs, GyroFs, Odr, DAT
 use super::write_log::{RegisterWrite, WriteLog};
 use super::PhysicalSample;
 
+use super::spi_phase::SpiPhase;
 use fifo::Fifo;
 use i2c::I2cState;
 use interrupts::Pulse;
-use spi::SpiPhase;
 
 /// Capacity of the register write log (entries of 4 bytes).
 pub const WRITE_LOG_LEN: usize = 128;

@@ -66,10 +66,10 @@ use super::ak8963::Ak8963;
 use super::write_log::{RegisterWrite, WriteLog};
 use super::PhysicalSample;
 
+use super::spi_phase::SpiPhase;
 use aux_master::AuxState;
 use fifo::Fifo;
 use i2c::I2cState;
-use spi::SpiPhase;
 
 /// Capacity of the register write log (entries of 4 bytes).
 pub const WRITE_LOG_LEN: usize = 128;
