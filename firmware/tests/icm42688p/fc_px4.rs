@@ -7,13 +7,16 @@
 //! FIFO read. On each INT1 assertion: one burst from INT_STATUS 0x2D returning INT_STATUS,
 //! FIFO_COUNTH, FIFO_COUNTL and the packets; each header must have ACCEL, GYRO and 20 set,
 //! HEADER_MSG and the ODR-change bits clear and TIMESTAMP_FSYNC = 10 (0x78). Accel is decoded
-//! as the 20-bit value / 4, gyro / 2. Every 10th transfer, one register of each bank 0–2 is
-//! checked in rotation.
+//! as the 20-bit value / 4, gyro / 2. After a FIFO read more than 100 ms after the last check,
+//! one register of each bank 0–2 is checked, in rotation.
 
 use super::fc::{Decoded, Recorder, Rig, Run};
 use super::*;
 
 const PACKET: usize = 20;
+/// PX4 checks one configured register of each bank after a FIFO read once more than 100 ms
+/// have passed since the last check.
+pub const CHECK_INTERVAL_NS: u64 = 100 * MS;
 const SAMPLES: usize = 8;
 
 /// (bank, register, set bits, clear bits), as PX4 configures them.
@@ -99,7 +102,7 @@ pub fn px4_sequence(rig: &mut impl Rig, n: usize) -> Run {
     p.r.rig.loop_starts();
 
     let t0 = 40 * MS;
-    let mut transfers = 0usize;
+    let (mut last_check, mut checks) = (t0, 0usize);
     for k in 0..n {
         let t = t0 + k as u64 * 125 * US;
         p.r.latch(k as i16, t, Some((2, 1)));
@@ -109,14 +112,14 @@ pub fn px4_sequence(rig: &mut impl Rig, n: usize) -> Run {
         p.select(0);
         let bytes = p.r.burst(0x2D, 3 + SAMPLES * PACKET);
         transfer(&mut p.r, &bytes);
-        transfers += 1;
-        if transfers % 10 == 0 {
-            let (b0, b1, b2) = (transfers / 10 % 17, transfers / 10 % 3, transfers / 10 % 2);
+        if t - last_check > CHECK_INTERVAL_NS {
+            let (b0, b1, b2) = (checks % 17, checks % 3, checks % 2);
             for cfg in [CONFIG[b0], CONFIG[17 + b1], CONFIG[20 + b2]] {
                 if !p.check(cfg) {
                     p.r.run.register_mismatches += 1;
                 }
             }
+            (last_check, checks) = (t, checks + 1);
         }
     }
     p.r.run

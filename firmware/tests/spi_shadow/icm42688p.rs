@@ -9,7 +9,7 @@ mod fc_ardupilot;
 #[path = "../icm42688p/fc_betaflight.rs"]
 mod fc_betaflight;
 #[path = "../icm42688p/fc_px4.rs"]
-mod fc_px4;
+pub mod fc_px4;
 
 use margemu_firmware::chip::{Chip, EmulatedChip, PhysicalSample};
 use margemu_protocol::regmap::icm42688p::image::ImageConfig;

@@ -367,10 +367,11 @@ fn flight_controller_sequences_hit_at_least_99_percent() {
 
 #[test]
 fn px4_icm42688p_misses_only_its_register_checks() {
-    // A documented limit, measured: every 10th FIFO transfer PX4 reads back one configured
-    // register of each bank 0–2 (in rotation, REG_BANK_SEL written around them) at its only
-    // clock, 24 MHz: a one-byte read whose address follows no fixed transaction, so its only
-    // data byte is the predicted stream's. The FIFO bursts themselves are predicted.
+    // A documented limit, measured: after a FIFO read more than 100 ms after its last check,
+    // PX4 reads back one configured register of each bank 0–2 (in rotation, REG_BANK_SEL
+    // written around them) at its only clock, 24 MHz: a one-byte read whose address follows no
+    // fixed transaction, so its only data byte is the predicted stream's. The FIFO bursts
+    // themselves are predicted.
     let m = measure(icm42688p, icm42688p::px4, SAMPLES);
     report("px4-icm42688p", &m);
     assert_eq!(m.divergences, 0);
@@ -386,10 +387,16 @@ fn px4_icm42688p_misses_only_its_register_checks() {
         m.fast_misses
     );
     let (reads, hits) = m.fast;
-    assert_eq!(reads as usize, bursts + 3 * (bursts / 10));
+    let check_reads = reads as usize - bursts;
+    let intervals = (SAMPLES as u64 * 125 * US / icm42688p::fc_px4::CHECK_INTERVAL_NS) as usize;
+    assert_eq!(check_reads % 3, 0, "three checks at a time");
     assert!(
-        checks + 5 >= 3 * (bursts / 10),
-        "nearly every check misses: {checks}"
+        (intervals.saturating_sub(1)..=intervals).contains(&(check_reads / 3)),
+        "one check of each bank per 100 ms: {check_reads} reads in {intervals} intervals"
+    );
+    assert!(
+        checks + 5 >= check_reads,
+        "nearly every check misses: {checks} of {check_reads}"
     );
     let burst_rate = (bursts - burst_misses) as f64 / bursts as f64;
     assert!(burst_rate >= 0.99, "bursts {:.2} %", 100.0 * burst_rate);
