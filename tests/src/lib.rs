@@ -2,7 +2,7 @@
 //! where the fixtures live; [`qemu`] builds the QEMU board firmware and boots it; [`drive`] is a
 //! scripted link host for either source mode; [`model_source`] prepares a scene for source
 //! mode (b) and predicts its images; [`served`] checks the device's Served reports against a
-//! prediction.
+//! prediction; [`qemu_session`] runs and checks one QEMU session of either source mode.
 
 use std::path::{Path, PathBuf};
 
@@ -11,6 +11,7 @@ use margemu::scene::Scene;
 pub mod drive;
 pub mod model_source;
 pub mod qemu;
+pub mod qemu_session;
 pub mod served;
 
 /// The workspace root.

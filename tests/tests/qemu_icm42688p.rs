@@ -21,20 +21,17 @@
 //! Skipped, with a message, where `qemu-system-arm` or a cross toolchain is missing; under
 //! `CI=true` that is a failure instead.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
 
 use margemu::scene::Scene;
-use margemu::stream::{Session, StreamConfig};
 use margemu_protocol::chip::ChipModel;
-use margemu_protocol::link::CRC32C;
-use margemu_tests::drive::{self, Samples, Script};
 use margemu_tests::model_source::ModelStream;
 use margemu_tests::motion_scene_text;
-use margemu_tests::qemu::{self, Qemu};
-use margemu_tests::served::ServedTap;
-use serialport::SerialPort;
+use margemu_tests::qemu;
+use margemu_tests::qemu_session::{
+    build_board, image_session, model_script, predicted_crcs, run_images, run_model, scratch,
+};
 
 /// The scene's chip: an ICM-42688-P on SPI, not at its power-on full scales, turned 90° about z.
 const CHIP: &str = r#"
@@ -68,82 +65,29 @@ fn icm_scene(rate_hz: u32, seed: u64) -> Scene {
     scene
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("margemu-qemu-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
-
 #[test]
 fn icm42688p_image_mode_serves_the_hosts_images_byte_for_byte() {
     if !qemu::prerequisites_or_skip("qemu_icm42688p (images)") {
         return;
     }
     let _one_qemu = QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner());
-    let t = Instant::now();
-    let elf = qemu::board_elf().unwrap_or_else(|e| panic!("board ELF: {e}"));
-    let build = t.elapsed();
+    let (elf, build) = build_board();
 
     let scene = icm_scene(IMAGE_RATE_HZ, 13);
     let dir = scratch("icm42688p-images");
-    let config = StreamConfig {
-        port: "qemu mps2-an386 UART0 (pty)".into(),
-        lead: Duration::from_millis(1500),
-        drain_timeout: Duration::from_secs(5),
-        ..StreamConfig::default()
-    };
-    let session = Session::new(&scene, config, &dir).unwrap_or_else(|e| panic!("session: {e}"));
+    let session = image_session(&scene, &dir);
     assert!(session
         .samples()
         .iter()
         .all(|s| s.image.len() == ChipModel::Icm42688p.image_len()));
-    let predicted: Vec<u32> = session
-        .samples()
-        .iter()
-        .map(|s| CRC32C.checksum(&s.image))
-        .collect();
+    let predicted = predicted_crcs(&session);
     let samples = (f64::from(IMAGE_RATE_HZ) * SECONDS) as usize;
     assert_eq!(predicted.len(), samples);
     // Noise on: no two consecutive predicted images are equal.
     assert!(predicted.windows(2).all(|w| w[0] != w[1]));
 
-    let t = Instant::now();
-    let (qemu, uart0) = Qemu::boot(&elf).unwrap_or_else(|e| panic!("boot: {e}"));
-    let mut writer = uart0.into_port();
-    let tap = ServedTap::new(writer.try_clone_native().expect("clone the PTY"));
-    let log = tap.log();
-    // As in qemu_stream: QEMU takes one received byte per turn of its main loop.
-    writer
-        .set_timeout(Duration::from_secs(2))
-        .expect("set the write timeout");
-    let result = session.run(tap, writer, |_| {});
-    let streamed = t.elapsed();
-    let summary = result.unwrap_or_else(|e| {
-        panic!(
-            "session: {e}; logs in {}\nQEMU printed:\n{}",
-            dir.display(),
-            qemu.output()
-        )
-    });
-    drop(qemu);
-
-    let (served, damaged) = std::mem::take(&mut *log.lock().expect("the tap's log"));
-    assert_eq!(damaged, 0, "damaged frames from the device");
-    assert_eq!(served.duplicates, 0, "indices reported served twice");
-    let check = served.check(&predicted);
-    assert!(
-        check.all_exact(),
-        "{}; logs in {}",
-        check.summary(),
-        dir.display()
-    );
-
-    let telemetry = summary.telemetry.expect("the device's final Telemetry");
-    assert_eq!(telemetry.underruns, 0, "{telemetry:?}");
-    assert_eq!(telemetry.overruns, 0, "{telemetry:?}");
-    assert_eq!(summary.sent, summary.samples, "{summary:?}");
-    assert_eq!(telemetry.samples_served, samples as u64, "{telemetry:?}");
-    let _ = std::fs::remove_dir_all(&dir);
+    let run = run_images(&elf, session, &dir, &predicted, samples);
+    let (summary, check, streamed) = (run.summary, run.check, run.streamed);
 
     eprintln!(
         "qemu_icm42688p (images): build {build:.2?}, boot + stream of {samples} 32-byte \
@@ -159,9 +103,7 @@ fn icm42688p_model_mode_serves_the_hosts_prediction_bit_for_bit() {
         return;
     }
     let _one_qemu = QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner());
-    let t = Instant::now();
-    let elf = qemu::board_elf().unwrap_or_else(|e| panic!("board ELF: {e}"));
-    let build = t.elapsed();
+    let (elf, build) = build_board();
 
     let scene = icm_scene(MODEL_RATE_HZ, 17);
     let stream = ModelStream::from_scene(&scene, DECIMATION).unwrap_or_else(|e| panic!("{e}"));
@@ -185,59 +127,9 @@ fn icm42688p_model_mode_serves_the_hosts_prediction_bit_for_bit() {
     // The full scales (and the ODR) travel as register overrides.
     assert!(!configure.overrides.is_empty(), "{configure:?}");
 
-    let script = Script {
-        configure,
-        samples: Samples::Kinematics(&stream.kinematics),
-        sample_rate: stream.params.truth_rate,
-        outputs: predicted.len() as u64,
-        lead: Duration::from_millis(1500),
-        batch: 10,
-        timeout: Duration::from_secs(5),
-    };
-    let t = Instant::now();
-    let (qemu, uart0) = Qemu::boot(&elf).unwrap_or_else(|e| panic!("boot: {e}"));
-    let report = drive::run(uart0.into_port(), &script)
-        .unwrap_or_else(|e| panic!("session: {e}\nQEMU printed:\n{}", qemu.output()));
-    let streamed = t.elapsed();
-    drop(qemu);
-
-    let check = report.served.check(&predicted);
-    assert!(
-        check.all_exact(),
-        "{}; {} batches, {} credit stalls, pacing {:?}; telemetry {:?}",
-        check.summary(),
-        report.batches,
-        report.credit_stalls,
-        report.jitter(),
-        report.telemetry
-    );
-    assert_eq!(report.damaged, 0, "damaged device frames");
-    assert_eq!(report.served.duplicates, 0, "instants reported twice");
-    assert!(
-        report.errors.is_empty(),
-        "device errors: {:?}",
-        report.errors
-    );
-    assert!(
-        report.stopped,
-        "no stopped Telemetry: {:?}",
-        report.telemetry
-    );
-    let telemetry = report.telemetry.expect("stopped Telemetry");
-    assert_eq!(
-        (
-            telemetry.overruns,
-            telemetry.crc_errors,
-            telemetry.framing_errors
-        ),
-        (0, 0, 0),
-        "{telemetry:?}"
-    );
-    assert_eq!(
-        (telemetry.samples_served, telemetry.underruns),
-        (outputs as u64, 0),
-        "{telemetry:?}"
-    );
+    let script = model_script(&stream, configure);
+    let run = run_model(&elf, &script, &predicted, outputs as u64);
+    let (report, check, telemetry, streamed) = (run.report, run.check, run.telemetry, run.streamed);
 
     eprintln!(
         "qemu_icm42688p (model): build {build:.2?}, boot + stream {streamed:.2?}: {} of {} \

@@ -14,12 +14,11 @@
 //! `CI=true` that is a failure instead.
 
 use std::path::Path;
-use std::time::{Duration, Instant};
 
 use margemu::scene::Scene;
-use margemu_tests::drive::{self, Samples, Script};
 use margemu_tests::model_source::ModelStream;
-use margemu_tests::qemu::{self, Qemu};
+use margemu_tests::qemu;
+use margemu_tests::qemu_session::{build_board, model_script, run_model};
 use margemu_tests::SENSORS;
 
 /// Figure 3 motion; the [`SENSORS`] are appended.
@@ -64,9 +63,7 @@ fn model_mode_serves_the_hosts_prediction_bit_for_bit() {
     if !qemu::prerequisites_or_skip("qemu_model") {
         return;
     }
-    let t = Instant::now();
-    let elf = qemu::board_elf().unwrap_or_else(|e| panic!("board ELF: {e}"));
-    let build = t.elapsed();
+    let (elf, build) = build_board();
 
     let scene = Scene::parse_str(&format!("{MOTION}{SENSORS}"), Path::new("qemu-model.toml"))
         .unwrap_or_else(|e| panic!("{e}"));
@@ -76,61 +73,11 @@ fn model_mode_serves_the_hosts_prediction_bit_for_bit() {
     // Noise on: no two consecutive predicted images are equal, although the truth is held.
     assert!(stream.images.windows(2).all(|w| w[0] != w[1]));
 
-    let script = Script {
-        configure: stream.configure(50_000_000),
-        samples: Samples::Kinematics(&stream.kinematics),
-        sample_rate: stream.params.truth_rate,
-        outputs: predicted.len() as u64,
-        lead: Duration::from_millis(1500),
-        batch: 10,
-        timeout: Duration::from_secs(5),
-    };
-    let t = Instant::now();
-    let (qemu, uart0) = Qemu::boot(&elf).unwrap_or_else(|e| panic!("boot: {e}"));
-    let report = drive::run(uart0.into_port(), &script)
-        .unwrap_or_else(|e| panic!("session: {e}\nQEMU printed:\n{}", qemu.output()));
-    let streamed = t.elapsed();
-    drop(qemu);
-
-    let check = report.served.check(&predicted);
-    assert!(
-        check.all_exact(),
-        "{}; {} batches, {} credit stalls, pacing {:?}; telemetry {:?}",
-        check.summary(),
-        report.batches,
-        report.credit_stalls,
-        report.jitter(),
-        report.telemetry
-    );
-    assert_eq!(report.damaged, 0, "damaged device frames");
-    assert_eq!(report.served.duplicates, 0, "instants reported twice");
-    assert!(
-        report.errors.is_empty(),
-        "device errors: {:?}",
-        report.errors
-    );
-    assert!(
-        report.stopped,
-        "no stopped Telemetry: {:?}",
-        report.telemetry
-    );
-    let telemetry = report.telemetry.expect("stopped Telemetry");
-    assert_eq!(
-        (
-            telemetry.overruns,
-            telemetry.crc_errors,
-            telemetry.framing_errors
-        ),
-        (0, 0, 0),
-        "{telemetry:?}"
-    );
+    let script = model_script(&stream, stream.configure(50_000_000));
     // The device stops by itself at the scene's end (Start's end_index), before the host's Stop
     // arrives: every instant of the scene served, none after it, no underrun.
-    assert_eq!(
-        (telemetry.samples_served, telemetry.underruns),
-        (1000, 0),
-        "{telemetry:?}"
-    );
+    let run = run_model(&elf, &script, &predicted, 1000);
+    let (report, check, telemetry, streamed) = (run.report, run.check, run.telemetry, run.streamed);
 
     eprintln!(
         "qemu_model: build {build:.2?}, boot + stream {streamed:.2?}: {} of {} images served \
