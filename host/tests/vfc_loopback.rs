@@ -6,9 +6,10 @@
 use margemu::evaluate::Evaluation;
 use margemu::offline::{FilterKind, FilterParams};
 use margemu::scene::Scene;
-use margemu::stream::StreamConfig;
+use margemu::stream::{ImageSettings, Session, StreamConfig};
 use margemu::vfc::{board, run_loopback, MagAlignment, OutputRate, VfcConfig, VfcRun};
 use margemu_protocol::chip::ChipModel;
+use serialport::TTYPort;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -73,6 +74,60 @@ fn evaluate(dir: &Path) -> Evaluation {
 
 fn config(kind: FilterKind) -> VfcConfig {
     VfcConfig::for_scene(&gentle(), FilterParams::defaults(kind))
+}
+
+/// The `device_time_us` of every ATTITUDE_QUATERNION in the session's `dut_attitude.csv`.
+fn attitude_times(dir: &Path) -> Vec<u64> {
+    let text = std::fs::read_to_string(dir.join("dut_attitude.csv")).unwrap();
+    text.lines()
+        .skip(1)
+        .filter(|l| l.contains("ATTITUDE_QUATERNION"))
+        .map(|l| l.split(',').nth(3).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// Asserts that the device reported each `(register, value, what)` written over `bus` (lower
+/// case) in the session's `register_writes.csv`.
+fn assert_wrote(dir: &Path, bus: &str, expected: &[(&str, &str, &str)]) {
+    let writes = std::fs::read_to_string(dir.join("register_writes.csv")).unwrap();
+    let wrote = |register: &str, value: &str| {
+        writes.lines().any(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            f.len() > 5 && f[2] == bus && f[4] == register && f[5] == value
+        })
+    };
+    for &(register, value, what) in expected {
+        assert!(
+            wrote(register, value),
+            "{what} not in register_writes.csv:\n{writes}"
+        );
+    }
+}
+
+/// Streams `scene`'s images for `settings` (logging into `dir`) to a virtual flight controller
+/// of `config` whose driver configures the chip otherwise; checks that the session failed, the
+/// device thread ended on the flight controller's error and no sample was read; returns that
+/// error.
+fn run_mismatched(scene: &Scene, dir: &Path, settings: ImageSettings, config: VfcConfig) -> String {
+    let stream = StreamConfig {
+        port: "pty".into(),
+        images: Some(settings),
+        ..StreamConfig::default()
+    };
+    let session = Session::new(scene, stream, dir).unwrap();
+    let (host, device) = TTYPort::pair().unwrap();
+    let (rig, _fc_port) = margemu::vfc::spawn(device, config, settings.chip).unwrap();
+    let result = session.run_on_port(host, |_| {});
+    let out = rig.stop();
+    assert!(result.is_err(), "{result:?}");
+    let why = out.fc.error.unwrap();
+    assert!(
+        out.device.ended.starts_with("virtual flight controller: "),
+        "{}",
+        out.device.ended
+    );
+    assert_eq!(out.fc.samples, 0);
+    why
 }
 
 #[test]
@@ -156,13 +211,7 @@ fn every_sample_output_and_the_drivers_writes_in_the_session_log() {
     let filtered = fc.samples - fc.warmup;
     assert_eq!(fc.sent.get("ATTITUDE_QUATERNION"), Some(&filtered), "{fc}");
     // device_time_us: sample instants (5 ms apart) from the first filtered one, at 10 ms.
-    let text = std::fs::read_to_string(dir.join("dut_attitude.csv")).unwrap();
-    let times: Vec<u64> = text
-        .lines()
-        .skip(1)
-        .filter(|l| l.contains("ATTITUDE_QUATERNION"))
-        .map(|l| l.split(',').nth(3).unwrap().parse().unwrap())
-        .collect();
+    let times = attitude_times(&dir);
     assert_eq!(times.len() as u64, filtered);
     assert_eq!(times[0], 10_000);
     assert!(
@@ -171,60 +220,32 @@ fn every_sample_output_and_the_drivers_writes_in_the_session_log() {
     );
     assert!(times.windows(2).all(|w| w[0] < w[1]));
     // The driver set the device's chip up over the bus: the device reported its writes.
-    let writes = std::fs::read_to_string(dir.join("register_writes.csv")).unwrap();
     let bus = margemu::vfc::board::BUS.to_lowercase();
-    let wrote = |register: &str, value: &str| {
-        writes.lines().any(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            f.len() > 5 && f[2] == bus && f[4] == register && f[5] == value
-        })
-    };
-    for (register, value, what) in [
-        ("107", "128", "PWR_MGMT_1: reset"),
-        ("27", "24", "GYRO_CONFIG: ±2000 °/s"),
-        ("28", "24", "ACCEL_CONFIG: ±16 g"),
-        ("25", "4", "SMPLRT_DIV: 200 Hz"),
-        ("56", "1", "INT_ENABLE: raw data ready"),
-    ] {
-        assert!(
-            wrote(register, value),
-            "{what} not in register_writes.csv:\n{writes}"
-        );
-    }
+    assert_wrote(
+        &dir,
+        &bus,
+        &[
+            ("107", "128", "PWR_MGMT_1: reset"),
+            ("27", "24", "GYRO_CONFIG: ±2000 °/s"),
+            ("28", "24", "ACCEL_CONFIG: ±16 g"),
+            ("25", "4", "SMPLRT_DIV: 200 Hz"),
+            ("56", "1", "INT_ENABLE: raw data ready"),
+        ],
+    );
 }
 
 #[test]
 fn images_for_other_full_scales_stop_the_device_with_the_reason() {
-    use margemu::stream::{ImageSettings, Session};
-    use serialport::TTYPort;
     let scene = gentle();
     let dir = scratch("mismatch");
     // The host predicts images for the chip's power-on full scales (±2 g, ±250 °/s), which the
     // flight controller's driver changes.
     let settings = ImageSettings::for_scene(&scene);
-    let stream = StreamConfig {
-        port: "pty".into(),
-        images: Some(settings),
-        ..StreamConfig::default()
-    };
-    let session = Session::new(&scene, stream, &dir).unwrap();
-    let (host, device) = TTYPort::pair().unwrap();
-    let (rig, _fc_port) =
-        margemu::vfc::spawn(device, config(FilterKind::Ekf), settings.chip).unwrap();
-    let result = session.run_on_port(host, |_| {});
-    let out = rig.stop();
-    assert!(result.is_err(), "{result:?}");
-    let why = out.fc.error.unwrap();
+    let why = run_mismatched(&scene, &dir, settings, config(FilterKind::Ekf));
     assert!(
         why.contains("but the host computed its images for"),
         "{why}"
     );
-    assert!(
-        out.device.ended.starts_with("virtual flight controller: "),
-        "{}",
-        out.device.ended
-    );
-    assert_eq!(out.fc.samples, 0);
 }
 
 /// The gentle scene on an ICM-42688-P, as `--chip icm42688p` makes it.
@@ -310,52 +331,36 @@ fn on_the_icm42688p_every_sample_output_and_the_drivers_writes_in_the_session_lo
     assert_eq!(fc.samples, 600, "{fc}");
     assert_eq!(fc.sent.get("ATTITUDE_QUATERNION"), Some(&600), "{fc}");
     // device_time_us: every sample instant, 5 ms apart from the first one, at 0.
-    let text = std::fs::read_to_string(dir.join("dut_attitude.csv")).unwrap();
-    let times: Vec<u64> = text
-        .lines()
-        .skip(1)
-        .filter(|l| l.contains("ATTITUDE_QUATERNION"))
-        .map(|l| l.split(',').nth(3).unwrap().parse().unwrap())
-        .collect();
+    let times = attitude_times(&dir);
     assert_eq!(times, (0..600).map(|k| k * 5000).collect::<Vec<u64>>());
     // The icm426xx driver set the device's chip up over SPI: the device reported its writes.
-    let writes = std::fs::read_to_string(dir.join("register_writes.csv")).unwrap();
-    let wrote = |register: &str, value: &str| {
-        writes.lines().any(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            f.len() > 5 && f[2] == "spi" && f[4] == register && f[5] == value
-        })
-    };
-    for (register, value, what) in [
-        ("17", "1", "DEVICE_CONFIG: soft reset"),
-        (
-            "20",
-            "7",
-            "INT_CONFIG: INT1 latched, push-pull, active high",
-        ),
-        ("22", "192", "FIFO_CONFIG: stop on full"),
-        ("79", "7", "GYRO_CONFIG0: ±2000 °/s, 200 Hz"),
-        ("80", "7", "ACCEL_CONFIG0: ±16 g, 200 Hz"),
-        (
-            "95",
-            "55",
-            "FIFO_CONFIG1: 20-bit accel, gyro, temperature, watermark",
-        ),
-        ("96", "20", "FIFO_CONFIG2: watermark of one packet"),
-        ("101", "20", "INT_SOURCE0: FIFO threshold to INT1"),
-        ("78", "15", "PWR_MGMT0: gyro and accel low noise"),
-    ] {
-        assert!(
-            wrote(register, value),
-            "{what} not in register_writes.csv:\n{writes}"
-        );
-    }
+    assert_wrote(
+        &dir,
+        "spi",
+        &[
+            ("17", "1", "DEVICE_CONFIG: soft reset"),
+            (
+                "20",
+                "7",
+                "INT_CONFIG: INT1 latched, push-pull, active high",
+            ),
+            ("22", "192", "FIFO_CONFIG: stop on full"),
+            ("79", "7", "GYRO_CONFIG0: ±2000 °/s, 200 Hz"),
+            ("80", "7", "ACCEL_CONFIG0: ±16 g, 200 Hz"),
+            (
+                "95",
+                "55",
+                "FIFO_CONFIG1: 20-bit accel, gyro, temperature, watermark",
+            ),
+            ("96", "20", "FIFO_CONFIG2: watermark of one packet"),
+            ("101", "20", "INT_SOURCE0: FIFO threshold to INT1"),
+            ("78", "15", "PWR_MGMT0: gyro and accel low noise"),
+        ],
+    );
 }
 
 #[test]
 fn on_the_icm42688p_images_for_other_full_scales_stop_the_device_with_the_reason() {
-    use margemu::stream::{ImageSettings, Session};
-    use serialport::TTYPort;
     // The scene's [chip] sets ±4 g and ±500 °/s, the host predicts images for them, and the
     // icm426xx driver sets ±16 g and ±2000 °/s.
     let text =
@@ -367,27 +372,10 @@ fn on_the_icm42688p_images_for_other_full_scales_stop_the_device_with_the_reason
         settings.chip,
         board::chip_settings(ChipModel::Icm42688p).unwrap()
     );
-    let stream = StreamConfig {
-        port: "pty".into(),
-        images: Some(settings),
-        ..StreamConfig::default()
-    };
-    let session = Session::new(&scene, stream, &dir).unwrap();
-    let (host, device) = TTYPort::pair().unwrap();
     let config = VfcConfig::for_scene(&scene, FilterParams::defaults(FilterKind::Ekf));
-    let (rig, _fc_port) = margemu::vfc::spawn(device, config, settings.chip).unwrap();
-    let result = session.run_on_port(host, |_| {});
-    let out = rig.stop();
-    assert!(result.is_err(), "{result:?}");
-    let why = out.fc.error.unwrap();
+    let why = run_mismatched(&scene, &dir, settings, config);
     assert!(
         why.contains("the driver configured the chip as Icm42688p(ImageConfig { accel_fs: G16, gyro_fs: Dps2000 }), but the host computed its images for Icm42688p(ImageConfig { accel_fs: G4, gyro_fs: Dps500 })"),
         "{why}"
     );
-    assert!(
-        out.device.ended.starts_with("virtual flight controller: "),
-        "{}",
-        out.device.ended
-    );
-    assert_eq!(out.fc.samples, 0);
 }
