@@ -36,6 +36,8 @@
 //! ±full scale and beyond it (saturation), negative values, −40 … 85 °C; every value the crate
 //! returns must be within one LSB of the latched sample (clipped as the register clips).
 
+mod driver_support;
+
 use embedded_hal_compat::{Reverse, ReverseCompat};
 use icm42688::prelude::*;
 use icm42688::{
@@ -142,21 +144,8 @@ fn samples(
             temp_c: -40.0 + 16.0 * i as f32,
         });
     }
-    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.6 - 1.3
-    };
-    for _ in 0..24 {
-        out.push(PhysicalSample {
-            acc: [0; 3].map(|_| (next() * a_fs) as f32),
-            gyr: [0; 3].map(|_| (next() * g_fs) as f32),
-            mag: [0.0; 3],
-            temp_c: (22.5 + next() * 48.0) as f32,
-        });
-    }
+    let state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    out.extend(driver_support::random_samples(state, a_fs, g_fs).take(24));
     out
 }
 

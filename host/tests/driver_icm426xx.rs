@@ -34,6 +34,8 @@
 //!   agrees with the datasheet: its `TEMP_SENSITIVITY_2_BYTE` is 1/132.48 "for data register
 //!   and FIFO high res. data conversion".)
 
+mod driver_support;
+
 use embedded_hal::spi::SpiDevice as _;
 use icm426xx::fifo::FifoPacket4;
 use icm426xx::{Config, Error, Sample, Timestamp, ICM42688};
@@ -88,21 +90,10 @@ fn samples(n: usize) -> Vec<PhysicalSample> {
             temp_c: -40.0 + 12.5 * i as f32,
         });
     }
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.6 - 1.3
-    };
-    while out.len() < n {
-        out.push(PhysicalSample {
-            acc: [0; 3].map(|_| (next() * accel_fs) as f32),
-            gyr: [0; 3].map(|_| (next() * gyro_fs) as f32),
-            mag: [0.0; 3],
-            temp_c: (22.5 + next() * 48.0) as f32,
-        });
-    }
+    let random = n.saturating_sub(out.len());
+    out.extend(
+        driver_support::random_samples(0x2545_F491_4F6C_DD1D, accel_fs, gyro_fs).take(random),
+    );
     out
 }
 

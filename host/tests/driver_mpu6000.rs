@@ -20,15 +20,16 @@
 //! - `set_i2c_disable` writes bit 2 of USER_CTRL (FIFO_RST), not bit 4 (I2C_IF_DIS): the
 //!   chip's I2C interface stays on, pinned below.
 
+mod driver_support;
+
+use driver_support::{new_mpu6000 as new_chip, Spread, Worst, FRACTIONS, G};
 use embedded_hal_02::blocking::delay::{DelayMs, DelayUs};
 use embedded_hal_compat::ReverseCompat;
 use margemu::bus::{self, Shared};
-use margemu_firmware::chip::{Config, I2cTarget, Mpu6xxx as Chip, PhysicalSample, Variant};
+use margemu_firmware::chip::{I2cTarget, Mpu6xxx as Chip, PhysicalSample};
 use mpu6000::bus::{RegAccess, SpiBus};
 use mpu6000::registers::{AccelerometerSensitive, GyroSensitive};
 use mpu6000::{ClockSource, FifoEnable, MPU6000};
-
-const G: f64 = 9.80665;
 
 /// The driver's 0.2 delays (embedded-hal-compat reverses only `u16`/`u32` delays); the chip
 /// needs no real time to pass.
@@ -45,13 +46,6 @@ impl DelayMs<u8> for NoDelay {
 /// `Result::unwrap` for the driver's error types, which do not implement `Debug`.
 fn ok<T, E>(result: Result<T, E>, what: &str) -> T {
     result.unwrap_or_else(|_| panic!("{what}: bus error"))
-}
-
-fn new_chip() -> Shared<Chip> {
-    bus::shared(Chip::with_config(Config {
-        variant: Variant::Mpu6000,
-        ..Config::default()
-    }))
 }
 
 /// The driver over SPI, the crate's own bus wrapper on the reversed adapters.
@@ -90,26 +84,16 @@ const GYRO: [(GyroSensitive, f64, f64); 4] = [
     (GyroSensitive::Sensitive16_4, 2000.0, 16.4),
 ];
 
-/// Fractions of full scale the samples take: zero, small, negative, just inside, at and beyond
-/// both ends (the register saturates at −32768 and 32767).
-const FRACTIONS: [f64; 11] = [
-    0.0, 7.7e-3, 0.3, -0.3, 0.999, -0.999, 1.0, -1.0, 1.7, -2.5, -0.61,
-];
+/// Each axis a different fraction of full scale; 20 °C, then 1.7 °C warmer a sample.
+const SPREAD: Spread = Spread {
+    acc: [0, 3, 7],
+    gyr: [1, 5, 9],
+    temp_c: [20.0, 1.7],
+};
 
-/// Sample `i` at the given full scales: each axis a different fraction of full scale.
+/// Sample `i` at the given full scales.
 fn sample(i: usize, accel_g: f64, gyro_dps: f64) -> PhysicalSample {
-    let f = |j: usize| FRACTIONS[(i + j) % FRACTIONS.len()];
-    PhysicalSample {
-        acc: [0, 3, 7].map(|j| (f(j) * accel_g * G) as f32),
-        gyr: [1, 5, 9].map(|j| (f(j) * gyro_dps).to_radians() as f32),
-        mag: [0.0; 3],
-        temp_c: 20.0 + i as f32 * 1.7,
-    }
-}
-
-/// `value` (in LSB) clipped like the register.
-fn clip(value: f64) -> f64 {
-    value.clamp(-32768.0, 32767.0)
+    driver_support::sample(&SPREAD, i, accel_g, gyro_dps)
 }
 
 #[test]
@@ -118,7 +102,7 @@ fn every_full_scale_within_one_lsb() {
     let mut mpu = driver(&chip);
     set_up(&mut mpu, &chip);
     let mut t_ns = chip.borrow().now_ns();
-    let (mut worst, mut saturated) = ([0.0f64; 3], 0);
+    let mut worst = Worst::default();
     for (accel_sens, accel_g, accel_lsb) in ACCEL {
         for (gyro_sens, gyro_dps, gyro_lsb) in GYRO {
             ok(mpu.set_accelerometer_sensitive(accel_sens), "accel scale");
@@ -131,17 +115,9 @@ fn every_full_scale_within_one_lsb() {
                 let (accel_raw, gyro_raw) = (accel.0, gyro.0);
                 let accel_g_read = accel / accel_sens;
                 let gyro_dps_read = gyro / gyro_sens;
-                for axis in 0..3 {
-                    let ideal = clip(f64::from(s.acc[axis]) / G * accel_lsb);
-                    let got = f64::from(accel_g_read[axis]) * accel_lsb;
-                    worst[0] = worst[0].max((got - ideal).abs());
-                    let ideal_g = clip(f64::from(s.gyr[axis]).to_degrees() * gyro_lsb);
-                    let got_g = f64::from(gyro_dps_read[axis]) * gyro_lsb;
-                    worst[1] = worst[1].max((got_g - ideal_g).abs());
-                    saturated += usize::from(ideal.abs() >= 32767.0 || ideal_g.abs() >= 32767.0);
-                }
+                worst.add(&s, accel_g_read, gyro_dps_read, accel_lsb, gyro_lsb);
                 let ideal_t = (f64::from(s.temp_c) - 36.53) * 340.0;
-                worst[2] = worst[2].max((f64::from(temp.0) - ideal_t).abs());
+                worst.add_temperature((f64::from(temp.0) - ideal_t).abs());
                 let celsius = f64::from(temp.celcius().0) / 100.0;
                 assert!((celsius - f64::from(s.temp_c)).abs() < 0.02, "{celsius} °C");
                 // The single reads agree with the burst.
@@ -150,12 +126,7 @@ fn every_full_scale_within_one_lsb() {
             }
         }
     }
-    println!(
-        "worst deviation (LSB): accel {:.3}, gyro {:.3}, temperature {:.3}",
-        worst[0], worst[1], worst[2]
-    );
-    assert!(worst.iter().all(|&w| w <= 1.0), "{worst:?}");
-    assert!(saturated > 0, "some samples beyond full scale");
+    worst.check();
 }
 
 #[test]

@@ -17,9 +17,12 @@
 //! celsius` = raw / 340 + 36.53: the datasheet values the chip uses. The DMP (firmware upload
 //! through MEM_R_W, `initialize_dmp`) is not emulated and not used here.
 
+mod driver_support;
+
+use driver_support::{new_mpu6000 as new_chip, Spread, Worst, FRACTIONS};
 use embedded_hal::delay::DelayNs;
 use margemu::bus::{self, Shared};
-use margemu_firmware::chip::{Config, Mpu6xxx as Chip, PhysicalSample, Variant};
+use margemu_firmware::chip::{Config, Mpu6xxx as Chip, PhysicalSample};
 use mpu6050_dmp::accel::{Accel, AccelFullScale};
 use mpu6050_dmp::address::Address;
 use mpu6050_dmp::clock_source::ClockSource;
@@ -27,16 +30,7 @@ use mpu6050_dmp::config::DigitalLowPassFilter;
 use mpu6050_dmp::gyro::GyroFullScale;
 use mpu6050_dmp::sensor::Mpu6050;
 
-const G: f64 = 9.80665;
-
 type Driver = Mpu6050<bus::I2c<Chip>>;
-
-fn new_chip() -> Shared<Chip> {
-    bus::shared(Chip::with_config(Config {
-        variant: Variant::Mpu6000,
-        ..Config::default()
-    }))
-}
 
 /// The driver on its own I2C adapter; its constructor wakes the chip.
 fn driver(chip: &Shared<Chip>) -> Driver {
@@ -80,30 +74,22 @@ const GYRO: [(GyroFullScale, f64); 4] = [
     (GyroFullScale::Deg2000, 2000.0),
 ];
 
-/// Fractions of full scale: zero, small, negative, just inside, at and beyond both ends.
-const FRACTIONS: [f64; 11] = [
-    0.0, 7.7e-3, 0.3, -0.3, 0.999, -0.999, 1.0, -1.0, 1.7, -2.5, -0.61,
-];
+/// Each axis a different fraction of full scale; 15 °C, then 2.3 °C warmer a sample.
+const SPREAD: Spread = Spread {
+    acc: [2, 4, 8],
+    gyr: [1, 6, 10],
+    temp_c: [15.0, 2.3],
+};
 
 fn sample(i: usize, accel_g: f64, gyro_dps: f64) -> PhysicalSample {
-    let f = |j: usize| FRACTIONS[(i + j) % FRACTIONS.len()];
-    PhysicalSample {
-        acc: [2, 4, 8].map(|j| (f(j) * accel_g * G) as f32),
-        gyr: [1, 6, 10].map(|j| (f(j) * gyro_dps).to_radians() as f32),
-        mag: [0.0; 3],
-        temp_c: 15.0 + i as f32 * 2.3,
-    }
-}
-
-fn clip(value: f64) -> f64 {
-    value.clamp(-32768.0, 32767.0)
+    driver_support::sample(&SPREAD, i, accel_g, gyro_dps)
 }
 
 #[test]
 fn every_full_scale_within_one_lsb() {
     let chip = new_chip();
     let mut mpu = driver(&chip);
-    let (mut worst, mut saturated) = ([0.0f64; 3], 0);
+    let mut worst = Worst::default();
     for (accel_fs, accel_g) in ACCEL {
         for (gyro_fs, gyro_dps) in GYRO {
             configure(&mut mpu, &chip, accel_fs, gyro_fs);
@@ -118,24 +104,13 @@ fn every_full_scale_within_one_lsb() {
                 let a = accel.scaled(accel_fs);
                 let w = gyro.scaled(gyro_fs);
                 let (a, w) = ([a.x(), a.y(), a.z()], [w.x(), w.y(), w.z()]);
-                for axis in 0..3 {
-                    let ideal = clip(f64::from(s.acc[axis]) / G * accel_lsb);
-                    worst[0] = worst[0].max((f64::from(a[axis]) * accel_lsb - ideal).abs());
-                    let ideal_w = clip(f64::from(s.gyr[axis]).to_degrees() * gyro_lsb);
-                    worst[1] = worst[1].max((f64::from(w[axis]) * gyro_lsb - ideal_w).abs());
-                    saturated += usize::from(ideal.abs() >= 32767.0 || ideal_w.abs() >= 32767.0);
-                }
+                worst.add(&s, a, w, accel_lsb, gyro_lsb);
                 let celsius = f64::from(mpu.temperature().unwrap().celsius());
-                worst[2] = worst[2].max((celsius - f64::from(s.temp_c)).abs() * 340.0);
+                worst.add_temperature((celsius - f64::from(s.temp_c)).abs() * 340.0);
             }
         }
     }
-    println!(
-        "worst deviation (LSB): accel {:.3}, gyro {:.3}, temperature {:.3}",
-        worst[0], worst[1], worst[2]
-    );
-    assert!(worst.iter().all(|&w| w <= 1.0), "{worst:?}");
-    assert!(saturated > 0, "some samples beyond full scale");
+    worst.check();
 }
 
 #[test]
