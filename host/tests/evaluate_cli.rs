@@ -3,28 +3,15 @@
 //! (37 ms late, on a device clock 80 ppm slow, with arrival jitter and attitude noise); and a
 //! `simulate` run of the paper's case study scored from an estimates file.
 
+mod common;
 mod evaluate_common;
 
+use common::margemu;
 use evaluate_common::*;
 use margemu::evaluate::input::read_truth;
 use margemu::evaluate::quat::{euler, normalize};
 use margemu_model::rng::{stream, uniform};
 use std::path::Path;
-use std::process::Command;
-
-fn margemu(args: &[&std::ffi::OsStr]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
-        .args(args)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
 
 /// The number after `key` in `text` (up to the next space).
 fn number_after(text: &str, key: &str) -> f64 {

@@ -1,6 +1,9 @@
 //! `margemu loopback`: the real firmware link handler behind a pseudo-terminal pair serves
 //! every sample, and every image it served equals the host's prediction byte for byte.
 
+mod common;
+
+use std::ffi::OsStr;
 use std::process::Command;
 
 fn loopback(scene_text: &str, name: &str) -> String {
@@ -13,20 +16,15 @@ fn loopback_with(scene_text: &str, name: &str, args: &[&str]) -> String {
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("scene.toml");
     std::fs::write(&scene, scene_text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
-        .arg("loopback")
-        .arg(&scene)
-        .arg("-o")
-        .arg(dir.join("session"))
-        .args(args)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let session = dir.join("session");
+    let mut argv = vec![
+        OsStr::new("loopback"),
+        scene.as_os_str(),
+        "-o".as_ref(),
+        session.as_os_str(),
+    ];
+    argv.extend(args.iter().map(OsStr::new));
+    let stdout = common::margemu(&argv);
     for log in [
         "meta.toml",
         "truth.csv",

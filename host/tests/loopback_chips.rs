@@ -2,6 +2,9 @@
 //! real firmware link handler serves every image as the host predicted, byte for byte; the
 //! session's `meta.toml` records the chip; `--chip` swaps the chip of a scene.
 
+mod common;
+
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -15,20 +18,14 @@ fn fixture(name: &str) -> PathBuf {
 fn loopback(scene: &Path, tag: &str, args: &[&str]) -> (String, PathBuf) {
     let dir = std::env::temp_dir().join(format!("margemu-chips-{}-{tag}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
-        .arg("loopback")
-        .arg(scene)
-        .arg("-o")
-        .arg(&dir)
-        .args(args)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let mut argv = vec![
+        OsStr::new("loopback"),
+        scene.as_os_str(),
+        "-o".as_ref(),
+        dir.as_os_str(),
+    ];
+    argv.extend(args.iter().map(OsStr::new));
+    let stdout = common::margemu(&argv);
     (stdout, dir)
 }
 

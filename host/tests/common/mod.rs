@@ -1,10 +1,13 @@
-//! Shared by the streaming tests: scenes, scratch directories, the real firmware `Device` behind
+//! Shared by the streaming and command-line tests: the `margemu` binary run to success, scenes,
+//! scratch directories, the real firmware `Device` behind
 //! a PTY pair, and a strict reader of the session's CSV files.
 #![allow(dead_code)] // each test file uses its own part
 
 use margemu::scene::Scene;
 use margemu::stream::{StreamConfig, StreamError, Summary};
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 /// A kinematic scene with motion on two axes and gyro noise (so neighbouring images differ).
 pub fn scene(duration: f64, rate: f64) -> Scene {
@@ -15,6 +18,22 @@ pub fn scene(duration: f64, rate: f64) -> Scene {
          [sensors.gyro]\nnoise_density = [0.01, 0.01, 0.01]\n"
     );
     Scene::parse_str(&text, Path::new("stream-test.toml")).unwrap()
+}
+
+/// Runs the `margemu` binary with `args`; checks that it succeeded (showing its stdout and
+/// stderr if not) and returns its stdout.
+pub fn margemu(args: &[&OsStr]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
+        .args(args)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
 }
 
 /// A fresh directory under the system's temporary directory.
