@@ -91,11 +91,6 @@ const SPREAD: Spread = Spread {
     temp_c: [20.0, 1.7],
 };
 
-/// Sample `i` at the given full scales.
-fn sample(i: usize, accel_g: f64, gyro_dps: f64) -> PhysicalSample {
-    driver_support::sample(&SPREAD, i, accel_g, gyro_dps)
-}
-
 #[test]
 fn every_full_scale_within_one_lsb() {
     let chip = new_chip();
@@ -108,7 +103,7 @@ fn every_full_scale_within_one_lsb() {
             ok(mpu.set_accelerometer_sensitive(accel_sens), "accel scale");
             ok(mpu.set_gyro_sensitive(gyro_sens), "gyro scale");
             for i in 0..FRACTIONS.len() {
-                let s = sample(i, accel_g, gyro_dps);
+                let s = SPREAD.sample(i, accel_g, gyro_dps);
                 t_ns += 1_000_000;
                 chip.borrow_mut().latch_at(&s, t_ns);
                 let (accel, temp, gyro) = ok(mpu.read_all(), "read_all");
@@ -147,7 +142,7 @@ fn fifo_counter_counts_records() {
     let t0 = chip.borrow().now_ns();
     for k in 1..=5 {
         chip.borrow_mut()
-            .latch_at(&sample(k, 2.0, 250.0), t0 + k as u64 * 1_000_000);
+            .latch_at(&SPREAD.sample(k, 2.0, 250.0), t0 + k as u64 * 1_000_000);
     }
     assert_eq!(
         ok(mpu.get_fifo_counter(), "fifo count"),

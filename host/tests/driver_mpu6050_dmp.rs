@@ -81,10 +81,6 @@ const SPREAD: Spread = Spread {
     temp_c: [15.0, 2.3],
 };
 
-fn sample(i: usize, accel_g: f64, gyro_dps: f64) -> PhysicalSample {
-    driver_support::sample(&SPREAD, i, accel_g, gyro_dps)
-}
-
 #[test]
 fn every_full_scale_within_one_lsb() {
     let chip = new_chip();
@@ -95,7 +91,7 @@ fn every_full_scale_within_one_lsb() {
             configure(&mut mpu, &chip, accel_fs, gyro_fs);
             let (accel_lsb, gyro_lsb) = (accel_fs.scale() as f64, gyro_fs.scale() as f64);
             for i in 0..FRACTIONS.len() {
-                let s = sample(i, accel_g, gyro_dps);
+                let s = SPREAD.sample(i, accel_g, gyro_dps);
                 let t = chip.borrow().now_ns() + 1_000_000;
                 chip.borrow_mut().latch_at(&s, t);
                 let (accel, gyro) = mpu.motion6().unwrap();
@@ -145,7 +141,8 @@ fn fifo_through_the_driver() {
     mpu.enable_fifo().unwrap();
     for i in 0..3 {
         let t = chip.borrow().now_ns() + 1_000_000;
-        chip.borrow_mut().latch_at(&sample(i, 16.0, 2000.0), t);
+        chip.borrow_mut()
+            .latch_at(&SPREAD.sample(i, 16.0, 2000.0), t);
     }
     assert_eq!(mpu.get_fifo_count().unwrap(), 42);
     let mut buf = [0u8; 64];

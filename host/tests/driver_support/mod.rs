@@ -30,14 +30,16 @@ pub struct Spread {
     pub temp_c: [f32; 2],
 }
 
-/// Sample `i` at the given full scales: each axis a different fraction of full scale.
-pub fn sample(spread: &Spread, i: usize, accel_g: f64, gyro_dps: f64) -> PhysicalSample {
-    let f = |j: usize| FRACTIONS[(i + j) % FRACTIONS.len()];
-    PhysicalSample {
-        acc: spread.acc.map(|j| (f(j) * accel_g * G) as f32),
-        gyr: spread.gyr.map(|j| (f(j) * gyro_dps).to_radians() as f32),
-        mag: [0.0; 3],
-        temp_c: spread.temp_c[0] + i as f32 * spread.temp_c[1],
+impl Spread {
+    /// Sample `i` at the given full scales: each axis a different fraction of full scale.
+    pub fn sample(&self, i: usize, accel_g: f64, gyro_dps: f64) -> PhysicalSample {
+        let f = |j: usize| FRACTIONS[(i + j) % FRACTIONS.len()];
+        PhysicalSample {
+            acc: self.acc.map(|j| (f(j) * accel_g * G) as f32),
+            gyr: self.gyr.map(|j| (f(j) * gyro_dps).to_radians() as f32),
+            mag: [0.0; 3],
+            temp_c: self.temp_c[0] + i as f32 * self.temp_c[1],
+        }
     }
 }
 
