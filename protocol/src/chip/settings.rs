@@ -90,11 +90,11 @@ impl ChipSettings {
             Conversion::Icm42688p(cfg) => {
                 cfg.accel_fs = icm::AccelFs::ALL
                     .into_iter()
-                    .find(|a| icm_accel_range(*a) == fs.accel_g)
+                    .find(|a| a.range_g() == fs.accel_g)
                     .ok_or(SettingsError::AccelRange(fs.accel_g))?;
                 cfg.gyro_fs = icm::GyroFs::ALL
                     .into_iter()
-                    .find(|g| icm_gyro_range(*g) == fs.gyro_dps)
+                    .find(|g| g.range_dps() == fs.gyro_dps)
                     .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
             }
         }
@@ -108,10 +108,7 @@ impl ChipSettings {
                 .iter()
                 .map(|a| f64::from(a.range_g()))
                 .collect(),
-            Family::Icm42688p => icm::AccelFs::ALL
-                .iter()
-                .map(|a| icm_accel_range(*a))
-                .collect(),
+            Family::Icm42688p => icm::AccelFs::ALL.iter().map(|a| a.range_g()).collect(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -124,10 +121,7 @@ impl ChipSettings {
                 .iter()
                 .map(|g| f64::from(g.range_dps()))
                 .collect(),
-            Family::Icm42688p => icm::GyroFs::ALL
-                .iter()
-                .map(|g| icm_gyro_range(*g))
-                .collect(),
+            Family::Icm42688p => icm::GyroFs::ALL.iter().map(|g| g.range_dps()).collect(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -141,8 +135,8 @@ impl ChipSettings {
                 gyro_dps: f64::from(cfg.gyro_fs.range_dps()),
             },
             Conversion::Icm42688p(cfg) => FullScale {
-                accel_g: icm_accel_range(cfg.accel_fs),
-                gyro_dps: icm_gyro_range(cfg.gyro_fs),
+                accel_g: cfg.accel_fs.range_g(),
+                gyro_dps: cfg.gyro_fs.range_dps(),
             },
         }
     }
@@ -240,14 +234,4 @@ fn power_on_value(model: ChipModel, file: u8, reg: u8) -> u8 {
         (Family::Icm42688p, bank) => icm::reset_value(bank, reg),
         _ => 0,
     }
-}
-
-/// ± g of an ICM-42688-P accelerometer full scale.
-fn icm_accel_range(fs: icm::AccelFs) -> f64 {
-    32768.0 / f64::from(fs.lsb_per_g())
-}
-
-/// ± °/s of an ICM-42688-P gyroscope full scale (2000 · 2^−FS_SEL: 15.625 at the finest).
-fn icm_gyro_range(fs: icm::GyroFs) -> f64 {
-    2000.0 / f64::from(1u16 << fs.bits())
 }

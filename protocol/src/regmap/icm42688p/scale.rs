@@ -44,6 +44,11 @@ impl AccelFs {
             Self::G2 => 16384.0,
         }
     }
+
+    /// The range, ± g (2, 4, 8 or 16).
+    pub fn range_g(self) -> f64 {
+        32768.0 / f64::from(self.lsb_per_g())
+    }
 }
 
 /// Gyroscope full scale, GYRO_CONFIG0.GYRO_FS_SEL (bits 7:5).
@@ -103,6 +108,11 @@ impl GyroFs {
             Self::Dps31_25 => 1048.6,
             Self::Dps15_625 => 2097.2,
         }
+    }
+
+    /// The range, ± °/s: 2000 / 2^GYRO_FS_SEL (2000 down to 15.625).
+    pub fn range_dps(self) -> f64 {
+        2000.0 / f64::from(1u16 << self.bits())
     }
 }
 
