@@ -349,7 +349,7 @@ fn configure_names_the_chip() {
         bad[0] = code;
         assert_eq!(
             Message::parse(0x02, &bad),
-            Err(Error::InvalidValue),
+            Err(Error::UnknownChip),
             "{code}"
         );
     }

@@ -85,7 +85,6 @@ use margemu_protocol::link::{
 use margemu_protocol::PROTOCOL_VERSION;
 
 use crate::chip::{self, Chip, EmulatedChip};
-use margemu_protocol::chip::ChipModel;
 use setup::Model;
 
 /// The shortest image of any model (the 6xxx parts without magnetometer).
@@ -347,13 +346,14 @@ impl<const N: usize> Core<N> {
             Ok(m) => m,
             Err(e) => {
                 self.counters.rx.record_error(e);
-                let unknown_chip = frame.payload().first().filter(|&&c| {
-                    kind == Kind::Configure as u8 && ChipModel::from_code(c).is_none()
-                });
-                let (code, detail) = match (Kind::from_u8(kind), unknown_chip) {
+                // An unknown chip code is the first byte of Configure's payload.
+                let chip = frame.payload().first().copied().unwrap_or(0);
+                let (code, detail) = match (Kind::from_u8(kind), e) {
                     (None, _) => (ErrorCode::UnknownMessage, kind),
-                    (Some(_), Some(&chip)) => (ErrorCode::UnsupportedChip, chip),
-                    (Some(_), None) => (ErrorCode::MalformedMessage, kind),
+                    (Some(_), margemu_protocol::link::Error::UnknownChip) => {
+                        (ErrorCode::UnsupportedChip, chip)
+                    }
+                    (Some(_), _) => (ErrorCode::MalformedMessage, kind),
                 };
                 self.error(code, seq, u32::from(detail));
                 return;

@@ -38,6 +38,9 @@ pub enum Error {
     PayloadTooLong,
     /// A field holds a value outside its documented set (enum code, reserved bit, zero rate).
     InvalidValue,
+    /// A [`Configure`](super::Configure) names a chip code this version does not know (its
+    /// first payload byte).
+    UnknownChip,
     /// A message would not fit in [`MAX_PAYLOAD_LEN`](super::MAX_PAYLOAD_LEN) bytes.
     MessageTooLarge,
     /// The output buffer given to an emit or encode call is too small.
@@ -57,6 +60,7 @@ impl fmt::Display for Error {
             Self::PayloadTooShort => "message payload too short",
             Self::PayloadTooLong => "message payload too long",
             Self::InvalidValue => "field value out of range",
+            Self::UnknownChip => "unknown chip model code",
             Self::MessageTooLarge => "message larger than the maximum payload",
             Self::BufferTooSmall => "output buffer too small",
         })

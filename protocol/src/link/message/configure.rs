@@ -204,7 +204,7 @@ impl Configure {
     }
 
     pub(crate) fn parse(r: &mut Reader<'_>) -> Result<Self, Error> {
-        let chip = ChipModel::from_code(r.u8()?).ok_or(Error::InvalidValue)?;
+        let chip = ChipModel::from_code(r.u8()?).ok_or(Error::UnknownChip)?;
         let who_am_i = r.u8()?;
         let image_len = r.u8()?;
         let i2c_address = r.u8()?;
