@@ -2,6 +2,7 @@
 //! choose (identity, bus, address, full scales, output rates) and what is and is not emulated.
 
 use anyhow::Result;
+use margemu::scene::chip::{hexes, ranges};
 use margemu_protocol::chip::{ChipModel, ChipSettings};
 
 #[derive(clap::Args)]
@@ -37,26 +38,25 @@ fn list(values: impl Iterator<Item = String>) -> String {
 
 /// The description `margemu chips` prints for `model`.
 pub fn describe(model: ChipModel) -> String {
-    let hex = |v: &[u8]| list(v.iter().map(|b| format!("{b:#04x}")));
     let power_on = ChipSettings::power_on(model).full_scale();
     let mut out = format!(
         "{} ([chip] model = \"{}\")\n",
         model.part_name(),
         model.name()
     );
-    out += &format!("  WHO_AM_I:     {}\n", hex(model.identities()));
+    out += &format!("  WHO_AM_I:     {}\n", hexes(model.identities()));
     out += &format!(
         "  buses:        SPI, I2C at {}\n",
-        hex(model.i2c_addresses())
+        hexes(model.i2c_addresses())
     );
     out += &format!(
         "  accel ranges: ± {} g (power-on ±{} g)\n",
-        list(ChipSettings::accel_ranges_g(model).map(|g| g.to_string())),
+        ranges(ChipSettings::accel_ranges_g(model)),
         power_on.accel_g
     );
     out += &format!(
         "  gyro ranges:  ± {} °/s (power-on ±{} °/s)\n",
-        list(ChipSettings::gyro_ranges_dps(model).map(|d| d.to_string())),
+        ranges(ChipSettings::gyro_ranges_dps(model)),
         power_on.gyro_dps
     );
     out += &format!("  output rates: {}\n", rates(model));

@@ -159,12 +159,14 @@ pub fn model_names() -> String {
     names.join(", ")
 }
 
-fn hexes(values: &[u8]) -> String {
+/// `0x68, 0x69`: register values or addresses, for messages.
+pub fn hexes(values: &[u8]) -> String {
     let v: Vec<String> = values.iter().map(|v| format!("{v:#04x}")).collect();
     v.join(", ")
 }
 
-fn ranges(values: impl Iterator<Item = f64>) -> String {
+/// `2, 4, 8, 16`: full scales, for messages.
+pub fn ranges(values: impl Iterator<Item = f64>) -> String {
     let v: Vec<String> = values.map(|v| v.to_string()).collect();
     v.join(", ")
 }

@@ -198,9 +198,7 @@ impl ChipModel {
             Self::Mpu9250 | Self::Mpu6500 | Self::Icm20602 => {
                 close(32_000.0) || close(8_000.0) || divided(1_000.0)
             }
-            Self::Icm42688p => (0..16u8)
-                .filter_map(crate::regmap::icm42688p::Odr::from_gyro_config0)
-                .any(|odr| close(1e9 / odr.period_ns() as f64)),
+            Self::Icm42688p => crate::regmap::icm42688p::Odr::gyro_of_hz(rate_hz).is_some(),
         }
     }
 }

@@ -153,9 +153,7 @@ impl ChipSettings {
             ],
             Conversion::Icm42688p(cfg) => {
                 let reset = |reg| icm::reset_value(0, reg);
-                let odr = (0..16u8)
-                    .filter_map(icm::Odr::from_gyro_config0)
-                    .find(|odr| (1e9 / odr.period_ns() as f64 - rate_hz).abs() <= 1e-9 * rate_hz)
+                let odr = icm::Odr::gyro_of_hz(rate_hz)
                     .map_or(reset(icm::bank0::GYRO_CONFIG0) & 0x0F, icm::Odr::bits);
                 [
                     (0, icm::bank0::GYRO_CONFIG0, cfg.gyro_fs.bits() << 5 | odr),

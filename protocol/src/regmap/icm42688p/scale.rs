@@ -184,6 +184,13 @@ impl Odr {
         }
     }
 
+    /// The gyro ODR of `hz` (within 1e-9 relative), if the gyro has one.
+    pub fn gyro_of_hz(hz: f64) -> Option<Self> {
+        (0..16u8)
+            .filter_map(Self::from_gyro_config0)
+            .find(|odr| (1e9 / odr.period_ns() as f64 - hz).abs() <= 1e-9 * hz)
+    }
+
     /// The 4-bit ODR code.
     pub const fn bits(self) -> u8 {
         match self {
