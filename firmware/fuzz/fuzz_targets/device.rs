@@ -7,4 +7,6 @@ use libfuzzer_sys::fuzz_target;
 #[path = "../device_ops.rs"]
 mod device_ops;
 
-fuzz_target!(|data: &[u8]| device_ops::run(data));
+fuzz_target!(|data: &[u8]| {
+    device_ops::run(data);
+});
