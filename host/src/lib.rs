@@ -3,6 +3,7 @@
 //!
 //! Layers, bottom up:
 //! - [`scene`]: the TOML scene file, validated with errors that point at file, line and column;
+//!   [`input_file`]: every file a scene reads is a regular file of bounded size;
 //! - [`reference`](mod@reference): each joint's reference signal (steps, waypoints, sines, random, CSV);
 //! - [`bench`](mod@bench): the closed-loop bench (eq. 5–17): joints, friction, PID synthesis, integrators;
 //! - [`motion`]: static, kinematic or bench motion, so a scene pays only for what it uses;
@@ -30,6 +31,7 @@ mod csv_table;
 pub mod demo;
 pub mod dut;
 pub mod evaluate;
+pub mod input_file;
 pub mod loopback;
 pub mod marg;
 pub mod motion;
