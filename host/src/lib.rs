@@ -10,6 +10,7 @@
 //! - [`truth`]: ground truth of the plate (attitude, rates, specific force, field) per sample;
 //! - [`bus`]: embedded-hal 1.0 adapters (SPI, I2C, delay) that put the emulated chip under unmodified drivers;
 //! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
+//! - [`guard`]: the run stops at the first truth or sample value that is not finite;
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
 //! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
@@ -31,6 +32,7 @@ mod csv_table;
 pub mod demo;
 pub mod dut;
 pub mod evaluate;
+pub mod guard;
 pub mod input_file;
 pub mod loopback;
 pub mod marg;

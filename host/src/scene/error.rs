@@ -105,7 +105,7 @@ impl SceneError {
             file: path.to_path_buf(),
             position: Some(line_col(text, text.len())),
             reason: format!(
-                "not UTF-8: byte 0x{:02x} at offset {} is not valid UTF-8",
+                "byte 0x{:02x} at offset {} is not UTF-8",
                 bytes[e.valid_up_to()],
                 e.valid_up_to()
             ),

@@ -131,6 +131,12 @@ impl Scene {
         self.clock.count_before(self.duration_ns)
     }
 
+    /// `file:line:col` of the value at key path `keys` (or of its nearest ancestor in the
+    /// file), for messages about what that value caused.
+    pub fn location(&self, keys: &[&str]) -> String {
+        SceneError::location(&self.path, &self.text, keys)
+    }
+
     /// The folder relative paths in the scene resolve against.
     pub fn base_dir(&self) -> &Path {
         self.path.parent().unwrap_or(Path::new("."))

@@ -26,6 +26,8 @@ const fn range(lo: f64, hi: f64, unit: &'static str) -> Plausible {
 /// `duration` and every time in a source (step times, holds, segments, CSV `t`): up to 10⁷ s
 /// (116 days).
 pub const TIME: Plausible = range(0.0, 1e7, "s");
+/// Times of a CSV joint source (`t` column; rows before t = 0 are allowed).
+pub const SOURCE_TIME: Plausible = range(-1e7, 1e7, "s");
 /// `rate`: 1 mHz to 1 MHz.
 pub const RATE: Plausible = range(1e-3, 1e6, "Hz");
 /// `integrator.step`: 1 ns to 10 s.
