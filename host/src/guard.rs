@@ -1,5 +1,6 @@
-//! The run stops at the first truth or sample value that is not finite, naming the sample, the
-//! value and the part of the scene that drives it, so no run ever writes NaN or ±∞.
+//! The run stops at the first truth or sample value that is not finite (or, for the truth, beyond
+//! the `f32` range its samples are rounded to), naming the sample, the value and the part of the
+//! scene that drives it, so no run ever writes NaN or ±∞.
 //!
 //! Validated inputs lie in plausible ranges ([`crate::scene::ranges`]), so a non-finite value
 //! comes from what the ranges cannot see: an explicit PID gain set that makes the bench unstable,
@@ -16,7 +17,7 @@ use crate::truth::Truth;
 
 // The doc comment is the message.
 #[derive(Debug, thiserror::Error, docsplay::Display)]
-/// sample {index} (t = {t_ns} ns): {quantity} is {value}, not finite; it comes from {driver}
+/// sample {index} (t = {t_ns} ns): {quantity} is {value}, {why}; it comes from {driver}
 pub struct NonFinite {
     /// Output sample index (0-based).
     pub index: u64,
@@ -26,6 +27,9 @@ pub struct NonFinite {
     pub quantity: String,
     /// Its value.
     pub value: f64,
+    /// "not finite", or "beyond the f32 range of the samples" for a finite truth value the
+    /// samples cannot hold.
+    pub why: &'static str,
     /// The scene part that drives it, with its `file:line:col`.
     pub driver: String,
 }
@@ -40,7 +44,7 @@ pub fn check_truth(
     truth: &Truth,
 ) -> Result<(), Box<NonFinite>> {
     let values = truth.columns();
-    let Some(k) = values.iter().position(|v| !v.is_finite()) else {
+    let Some(k) = values.iter().position(|v| !fits(*v)) else {
         return Ok(());
     };
     let non_finite = |quantity: String, value: f64, driver: String| {
@@ -49,12 +53,13 @@ pub fn check_truth(
             t_ns: truth.t_ns,
             quantity,
             value,
+            why: why(value),
             driver,
         })
     };
     for i in 0..JOINT_NAMES.len() {
         let triple = [joints.q[i], joints.qd[i], joints.qdd[i]];
-        let Some(d) = triple.iter().position(|v| !v.is_finite()) else {
+        let Some(d) = triple.iter().position(|v| !fits(*v)) else {
             continue;
         };
         let quantity = format!(
@@ -79,6 +84,19 @@ pub fn check_truth(
             )
         };
     Err(non_finite(column.to_owned(), values[k], driver))
+}
+
+/// Whether a truth value is finite and within the range of the `f32` samples made from it.
+fn fits(x: f64) -> bool {
+    x.abs() <= f64::from(f32::MAX)
+}
+
+fn why(x: f64) -> &'static str {
+    if x.is_finite() {
+        "beyond the f32 range of the samples (±3.4e38)"
+    } else {
+        "not finite"
+    }
 }
 
 /// What drives joint `i` at `t_ns`: its CSV rows, its source, or the bench dynamics.
@@ -136,6 +154,7 @@ pub fn check_sample(scene: &Scene, index: u64, s: &MargSample) -> Result<(), Box
         t_ns: s.t_ns,
         quantity: MARG_COLUMNS[k + 1].to_owned(),
         value: f64::from(value),
+        why: why(f64::from(value)),
         driver,
     }))
 }

@@ -47,13 +47,15 @@ pub enum Command {
     Tune(tune::Cmd),
 }
 
-/// Loads a scene file for a command and prints its warnings to stderr: the one place commands
-/// load scenes, so the warnings appear once per command.
+/// Loads a scene file for a command, reads and checks its CSV joint sources (so a bad source
+/// stops the command before it writes anything), and prints the scene's warnings to stderr:
+/// the one place commands load scenes, so the warnings appear once per command.
 pub fn load_scene(path: &std::path::Path) -> anyhow::Result<margemu::scene::Scene> {
     let scene = margemu::scene::Scene::load(path)?;
     for warning in &scene.warnings {
         eprintln!("warning: {warning}");
     }
+    margemu::motion::Motion::new(&scene)?;
     Ok(scene)
 }
 

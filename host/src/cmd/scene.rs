@@ -19,7 +19,6 @@ impl Cmd {
     pub fn run(self) -> Result<()> {
         let Cmd::Check { scene } = self;
         let scene = super::load_scene(&scene)?;
-        margemu::motion::Motion::new(&scene)?; // CSV sources are read and checked here.
         let spec = &scene.spec;
         println!(
             "ok: {}: {} samples at {} Hz over {} s, motion {:?}, {:?} integrator with {} s steps, seed {}",
