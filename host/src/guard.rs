@@ -17,7 +17,7 @@ use crate::truth::Truth;
 
 // The doc comment is the message.
 #[derive(Debug, thiserror::Error, docsplay::Display)]
-/// sample {index} (t = {t_ns} ns): {quantity} is {value}, {why}; it comes from {driver}
+/// sample {index} (t = {t_ns} ns): {quantity} is {value:e}, {why}; it comes from {driver}
 pub struct NonFinite {
     /// Output sample index (0-based).
     pub index: u64,
@@ -114,11 +114,18 @@ fn joint_driver(scene: &Scene, motion: &Motion, i: usize, t_ns: u64) -> String {
         )
     });
     match (scene.spec.motion, source) {
-        (MotionMode::Bench, source) => format!(
-            "the [bench] dynamics of joint {name} ({}: masses, friction, [control] gains){}",
-            scene.location(&["bench"]),
-            source.map_or(String::new(), |s| format!(" tracking {s}"))
-        ),
+        (MotionMode::Bench, source) => {
+            let gains = match scene.spec.control.gains {
+                Some(_) => scene.location(&["control", "gains"]),
+                None => scene.location(&["control"]),
+            };
+            format!(
+                "the [bench] dynamics of joint {name} (masses and friction at {}, [control] \
+                 gains at {gains}){}",
+                scene.location(&["bench"]),
+                source.map_or(String::new(), |s| format!(" tracking {s}"))
+            )
+        }
         (_, Some(source)) => source,
         (_, None) => format!(
             "[bench] initial of joint {name} ({})",
