@@ -132,6 +132,44 @@ mod tests {
         assert_eq!(GRAVITY.describe(), "[0, 1000] m/s²");
         assert_eq!(POLE_RATIO.describe(), "[1, 1000]");
         assert_eq!(TEMPERATURE.describe(), "[-273.15, 1000] °C");
+    }
+
+    /// The user guide's table lists every range as the code defines it.
+    #[test]
+    fn the_guide_lists_every_range() {
+        let guide = include_str!("../../../docs/scenes.md");
+        let all = [
+            TIME,
+            SOURCE_TIME,
+            RATE,
+            STEP,
+            MASS,
+            INERTIA,
+            VISCOUS_FRICTION,
+            STATIC_FRICTION,
+            EFFORT,
+            GRAVITY,
+            JOINT_VALUE,
+            COEFFICIENT,
+            FREQUENCY,
+            SMOOTHING_FREQUENCY,
+            DAMPING,
+            SETTLING_TIME,
+            POLE_RATIO,
+            GAIN,
+            EXTERNAL_ACCELERATION,
+            OSCILLATION_RATE,
+            FIELD,
+            SENSOR_TERM,
+            CORRELATION_TIME,
+            TEMPERATURE,
+            TEMPERATURE_SLOPE,
+            PERTURBATION_AMPLITUDE,
+        ];
+        for range in all {
+            let cell = format!("| {} |", range.describe());
+            assert!(guide.contains(&cell), "docs/scenes.md lacks {cell}");
+        }
         assert_eq!(
             MASS.refusal(1e308),
             "1e308 is outside the plausible range [1e-6, 1e6] kg"

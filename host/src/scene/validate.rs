@@ -79,10 +79,9 @@ fn check_sensors(spec: &SceneSpec) -> Check {
         }
     }
     if let Some(t) = &sensors.temperature {
-        all_finite(t, &["sensors", "temperature"], ranges::TEMPERATURE)?;
-        ranges::TEMPERATURE_SLOPE
-            .check(t[1], &["sensors", "temperature"])
-            .map_err(|v| v.index(1))?;
+        let at = ["sensors", "temperature"];
+        finite(t[0], &at, ranges::TEMPERATURE).map_err(|v| v.index(0))?;
+        finite(t[1], &at, ranges::TEMPERATURE_SLOPE).map_err(|v| v.index(1))?;
     }
     super::sensors::check_ranges(spec)?;
     Marg::new(&sensors.config(), spec.rate, spec.seed).map_err(model_violation)?;
