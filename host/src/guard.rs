@@ -57,14 +57,13 @@ pub fn check_truth(
             driver,
         })
     };
-    for i in 0..JOINT_NAMES.len() {
+    for (i, name) in JOINT_NAMES.iter().enumerate() {
         let triple = [joints.q[i], joints.qd[i], joints.qdd[i]];
         let Some(d) = triple.iter().position(|v| !fits(*v)) else {
             continue;
         };
         let quantity = format!(
-            "joint {} {}",
-            JOINT_NAMES[i],
+            "joint {name} {}",
             ["position", "velocity", "acceleration"][d]
         );
         let driver = joint_driver(scene, motion, i, truth.t_ns);

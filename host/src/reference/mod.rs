@@ -39,7 +39,7 @@ pub enum ReferenceError {
         /// Joint name.
         joint: String,
         /// The CSV problem (its text is part of the message, so it is not a `source`).
-        problem: TableError,
+        problem: Box<TableError>,
     },
     /// {0}
     NonFinite(Box<crate::guard::NonFinite>),
@@ -121,7 +121,7 @@ impl Reference {
                 .map_err(|problem| ReferenceError::Table {
                     at: scene.location(&["joints", name, "file"]),
                     joint: name.into(),
-                    problem,
+                    problem: Box::new(problem),
                 }),
         }
     }

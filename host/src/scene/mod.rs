@@ -151,3 +151,30 @@ impl Scene {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Gains that overflow are refused at the `[bench]` input they come from (validation's
+    /// ranges keep loaded scenes from getting here; this checks the last line of defence).
+    #[test]
+    fn non_finite_gains_are_refused_at_the_bench() {
+        let text = "duration = 1.0\nrate = 100.0\nseed = 1\n[bench]\nlink_mass = [1.0, 1.0, 1.0]\n";
+        let mut scene = Scene::parse_str(text, Path::new("gains.toml")).unwrap();
+        scene.spec.bench.link_mass = [1e300; 3];
+        scene.spec.bench.plate_mass = 1e308;
+        let e = scene.check_gains().unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "gains.toml:5:13: `bench.link_mass`: the PID gains of joint x are not finite \
+                 (Kp inf"
+            ),
+            "{e}"
+        );
+        assert!(
+            e.contains("from [bench] (link_mass, plate_mass, plate_inertia)"),
+            "{e}"
+        );
+    }
+}
