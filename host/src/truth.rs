@@ -54,23 +54,20 @@ impl Truth {
     /// Every value after the time stamp, in the order of the `truth.csv` columns
     /// ([`crate::output::TRUTH_COLUMNS`] after `t_ns`).
     pub fn columns(&self) -> [f64; 31] {
-        let groups: [&[f64]; 10] = [
-            &self.position,
-            &self.euler,
-            &self.quaternion,
-            &self.body_rate,
-            &self.specific_force,
-            &self.velocity,
-            &self.accel_world,
-            &self.accel_body,
-            &self.angular_accel,
-            &self.field_body,
-        ];
-        let mut out = [0.0; 31];
-        for (o, v) in out.iter_mut().zip(groups.iter().flat_map(|g| g.iter())) {
-            *o = *v;
-        }
-        out
+        let [x, y, z] = self.position;
+        let [roll, pitch, yaw] = self.euler;
+        let [qw, qx, qy, qz] = self.quaternion;
+        let [wx, wy, wz] = self.body_rate;
+        let [fx, fy, fz] = self.specific_force;
+        let [vx, vy, vz] = self.velocity;
+        let [awx, awy, awz] = self.accel_world;
+        let [abx, aby, abz] = self.accel_body;
+        let [dwx, dwy, dwz] = self.angular_accel;
+        let [mx, my, mz] = self.field_body;
+        [
+            x, y, z, roll, pitch, yaw, qw, qx, qy, qz, wx, wy, wz, fx, fy, fz, vx, vy, vz, awx,
+            awy, awz, abx, aby, abz, dwx, dwy, dwz, mx, my, mz,
+        ]
     }
 }
 
