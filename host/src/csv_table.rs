@@ -15,9 +15,9 @@ pub(crate) struct Table {
 impl Table {
     /// Opens `path` and reads its header row.
     pub fn open(path: &Path) -> Result<Self, ColumnError> {
-        let read_err = |source| ColumnError::Read {
+        let read_err = |cause| ColumnError::Read {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
@@ -63,13 +63,13 @@ impl Table {
         let mut record = csv::StringRecord::new();
         let mut rows = 0;
         loop {
-            let more =
-                self.reader
-                    .read_record(&mut record)
-                    .map_err(|source| ColumnError::Read {
-                        path: self.path.clone(),
-                        source,
-                    })?;
+            let more = self
+                .reader
+                .read_record(&mut record)
+                .map_err(|cause| ColumnError::Read {
+                    path: self.path.clone(),
+                    cause,
+                })?;
             if !more {
                 return Ok(rows);
             }

@@ -16,8 +16,10 @@ use std::path::{Path, PathBuf};
 /// A run that failed.
 #[derive(Debug, thiserror::Error, docsplay::Display)]
 pub enum RunError {
-    /// a joint reference could not be built
+    /// the scene's motion failed
     Reference(#[from] ReferenceError),
+    /// {0}
+    NonFinite(Box<crate::guard::NonFinite>),
     /// the sensor model refused the scene: {0}
     Model(margemu_model::Error),
     /// cannot write {path}
@@ -40,7 +42,8 @@ pub struct RunSummary {
 }
 
 /// Runs `scene`, calling `sink` with the truth of every output sample in time order and
-/// `progress(done, total)` every 4096 samples.
+/// `progress(done, total)` every 4096 samples. The run stops at the first truth value that is not
+/// finite ([`crate::guard::check_truth`]): [`ReferenceError::NonFinite`].
 pub fn run<E>(
     scene: &Scene,
     mut sink: impl FnMut(&Truth) -> Result<(), E>,
@@ -51,14 +54,25 @@ pub fn run<E>(
     let total = scene.samples();
     // A static plate's truth is the same at every instant but for the time stamp.
     let fixed = match &motion {
-        Motion::Static(pose) => Some(model.compute(0, pose)),
+        Motion::Static(pose) => {
+            let truth = model.compute(0, pose);
+            crate::guard::check_truth(scene, &motion, 0, pose, &truth)
+                .map_err(ReferenceError::NonFinite)?;
+            Some(truth)
+        }
         _ => None,
     };
     for k in 0..total {
         let t_ns = scene.clock.instant(k);
-        let truth = match fixed {
-            Some(truth) => Truth { t_ns, ..truth },
-            None => model.compute(t_ns, &motion.sample_at(t_ns)),
+        let truth = match &fixed {
+            Some(truth) => Truth { t_ns, ..*truth },
+            None => {
+                let joints = motion.sample_at(t_ns);
+                let truth = model.compute(t_ns, &joints);
+                crate::guard::check_truth(scene, &motion, k, &joints, &truth)
+                    .map_err(ReferenceError::NonFinite)?;
+                truth
+            }
         };
         if let Err(e) = sink(&truth) {
             return Ok(Err(e));
@@ -132,9 +146,8 @@ pub fn simulate_to_dir(
             source,
         };
         truth_out.write(t).map_err(|e| failed(&truth_path, e))?;
-        marg_out
-            .write(&marg.sample(t))
-            .map_err(|e| failed(&marg_path, e))
+        let sample = marg.try_sample(scene, t).map_err(RunError::NonFinite)?;
+        marg_out.write(&sample).map_err(|e| failed(&marg_path, e))
     };
     let summary = run(scene, sink, progress)??;
     truth_out.finish().map_err(write_err(&truth_path))?;

@@ -91,7 +91,7 @@ fn from_tuner(seeds: usize, max_evals: usize) -> Box<demo::Tuned<'static>> {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let mut scene = Scene::load(&self.scene)?;
+        let mut scene = super::load_scene(&self.scene)?;
         if let Some(seconds) = self.duration {
             if !(seconds.is_finite() && seconds > 0.0) {
                 bail!("--duration must be > 0 s, not {seconds}");

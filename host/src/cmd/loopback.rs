@@ -8,7 +8,6 @@ use super::stream::{finish_dut, prepare, stream_to, ChipArgs, DutArgs, SourceArg
 use super::vfc::VfcArgs;
 use anyhow::{bail, Context, Result};
 use margemu::dut::{DutConfig, DutProtocol};
-use margemu::scene::Scene;
 use margemu::stream::{ImageSettings, StreamConfig};
 use serialport::{SerialPort, TTYPort};
 use std::path::PathBuf;
@@ -27,12 +26,15 @@ pub struct Cmd {
     #[command(flatten)]
     dut: DutArgs,
     #[command(flatten)]
+    size: super::SizeArgs,
+    #[command(flatten)]
     vfc: VfcArgs,
 }
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = self.chip.apply(Scene::load(&self.scene)?)?;
+        let scene = self.chip.apply(super::load_scene(&self.scene)?)?;
+        self.size.check(&scene)?;
         let dir = self.output.clone().unwrap_or_else(|| {
             let stem = self.scene.file_stem().unwrap_or_default().to_string_lossy();
             PathBuf::from("sessions").join(format!("{stem}-loopback"))

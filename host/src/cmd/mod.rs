@@ -47,6 +47,34 @@ pub enum Command {
     Tune(tune::Cmd),
 }
 
+/// Loads a scene file for a command, reads and checks its CSV joint sources (so a bad source
+/// stops the command before it writes anything), and prints the scene's warnings to stderr:
+/// the one place commands load scenes, so the warnings appear once per command.
+pub fn load_scene(path: &std::path::Path) -> anyhow::Result<margemu::scene::Scene> {
+    let scene = margemu::scene::Scene::load(path)?;
+    for warning in &scene.warnings {
+        eprintln!("warning: {warning}");
+    }
+    margemu::motion::Motion::new(&scene)?;
+    Ok(scene)
+}
+
+/// The run-size limit of commands that run a whole scene (`margemu::scene::size`).
+#[derive(clap::Args)]
+pub struct SizeArgs {
+    /// Run a scene beyond 10 M samples or 2 GiB of estimated output.
+    #[arg(long)]
+    allow_large: bool,
+}
+
+impl SizeArgs {
+    /// The run's size, refused beyond the limits unless `--allow-large`.
+    pub fn check(&self, scene: &margemu::scene::Scene) -> anyhow::Result<()> {
+        margemu::scene::size::check(scene, self.allow_large)?;
+        Ok(())
+    }
+}
+
 impl Command {
     pub fn run(self) -> anyhow::Result<()> {
         match self {

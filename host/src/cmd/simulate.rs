@@ -2,7 +2,6 @@
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use margemu::scene::Scene;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -13,11 +12,14 @@ pub struct Cmd {
     /// Output directory (created if missing; existing files are replaced).
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    size: super::SizeArgs,
 }
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = Scene::load(&self.scene)?;
+        let scene = super::load_scene(&self.scene)?;
+        self.size.check(&scene)?;
         let bar =
             ProgressBar::with_draw_target(Some(scene.samples()), ProgressDrawTarget::hidden());
         bar.set_style(

@@ -40,6 +40,8 @@ pub struct Cmd {
     source: SourceArgs,
     #[command(flatten)]
     dut: DutArgs,
+    #[command(flatten)]
+    size: super::SizeArgs,
 }
 
 /// Which chip the device emulates.
@@ -136,7 +138,8 @@ impl SourceArgs {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = self.chip.apply(Scene::load(&self.scene)?)?;
+        let scene = self.chip.apply(super::load_scene(&self.scene)?)?;
+        self.size.check(&scene)?;
         let dir = self.output.clone().unwrap_or_else(|| {
             let stem = self.scene.file_stem().unwrap_or_default();
             PathBuf::from("sessions").join(stem)

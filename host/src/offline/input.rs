@@ -178,9 +178,9 @@ fn read_external(path: &Path, mag_reference: [f64; 3]) -> Result<Recording, Inpu
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_reader(std::io::BufReader::new(file));
-    let read_err = |source| ColumnError::Read {
+    let read_err = |cause| ColumnError::Read {
         path: path.to_path_buf(),
-        source,
+        cause,
     };
     let header = reader.headers().map_err(read_err)?.clone();
     if let Some(missing) = COLUMNS.iter().find(|c| !header.iter().any(|h| h == **c)) {
