@@ -10,6 +10,7 @@
 //! - [`bus`]: embedded-hal 1.0 adapters (SPI, I2C, delay) that put the emulated chip under unmodified drivers;
 //! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
+//! - [`rundir`]: which directory a run writes to, and the completion record written last;
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
 //! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
@@ -38,6 +39,7 @@ pub mod output;
 pub mod perf;
 pub mod reference;
 pub mod run;
+pub mod rundir;
 pub mod scene;
 pub mod stream;
 pub mod truth;

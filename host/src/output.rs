@@ -22,6 +22,10 @@
 use crate::truth::Truth;
 use std::io::{self, Write};
 
+/// The files `simulate` writes besides `meta.toml` (`perturbation.csv` only for scenes with a
+/// perturbation).
+pub const RUN_FILES: [&str; 3] = ["truth.csv", "marg.csv", "perturbation.csv"];
+
 /// Header of `truth.csv`.
 pub const TRUTH_COLUMNS: [&str; 32] = [
     "t_ns", "x", "y", "z", "roll", "pitch", "yaw", "qw", "qx", "qy", "qz", "wx", "wy", "wz", "fx",

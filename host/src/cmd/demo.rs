@@ -104,8 +104,7 @@ impl Cmd {
         };
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
-        ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
-            .context("installing the Ctrl-C handler")?;
+        super::on_signal(move || flag.store(true, Ordering::Relaxed))?;
         let (over, n, max) = demo::gyro_clipping(&scene)?;
         println!(
             "demo: {} ({} s at {} Hz) through loopback with the virtual flight controller: {} run(s) in real time",

@@ -17,9 +17,9 @@ use std::path::PathBuf;
 pub struct Cmd {
     /// The scene file (TOML).
     scene: PathBuf,
-    /// Session directory (default: sessions/<scene name>-loopback).
-    #[arg(short, long)]
-    output: Option<PathBuf>,
+    // Default: sessions/<scene name>-loopback.
+    #[command(flatten)]
+    output: super::OutputArgs,
     #[command(flatten)]
     chip: ChipArgs,
     #[command(flatten)]
@@ -33,16 +33,13 @@ pub struct Cmd {
 impl Cmd {
     pub fn run(self) -> Result<()> {
         let scene = self.chip.apply(Scene::load(&self.scene)?)?;
-        let dir = self.output.clone().unwrap_or_else(|| {
-            let stem = self.scene.file_stem().unwrap_or_default().to_string_lossy();
-            PathBuf::from("sessions").join(format!("{stem}-loopback"))
-        });
         let vfc = self.vfc.config(&scene)?;
         let settings = match vfc {
             Some(_) => margemu::vfc::image_settings(&scene)?,
             None => ImageSettings::for_scene(&scene),
         };
         let (host_end, device_end) = TTYPort::pair().context("opening a pseudo-terminal pair")?;
+        let dir = self.output.prepare(&self.scene, "sessions", "-loopback")?;
         let label = device_end
             .name()
             .unwrap_or_else(|| "a pseudo-terminal".into());

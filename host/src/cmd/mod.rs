@@ -1,5 +1,8 @@
 //! Subcommands of `margemu`, one file each.
 
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+
 pub mod analyze;
 pub mod bench;
 mod bench_stream;
@@ -15,15 +18,46 @@ pub mod stream;
 pub mod tune;
 mod vfc;
 
+/// Where a command writes its run or session directory (policy: [`margemu::rundir`]).
+#[derive(clap::Args)]
+pub struct OutputArgs {
+    /// The directory to write (created if missing). Without it, a fresh directory is made
+    /// under the default name, numbered (-2, -3, ...) if that one is taken.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Write into a non-empty --output directory: margemu's own files in it are removed first
+    /// (anything else there makes the command refuse).
+    #[arg(long, requires = "output")]
+    force: bool,
+}
+
+impl OutputArgs {
+    /// The directory, created and empty: --output, or `<parent>/<scene stem><suffix>` made
+    /// fresh.
+    pub fn prepare(&self, scene: &Path, parent: &str, suffix: &str) -> Result<PathBuf> {
+        let stem = scene.file_stem().unwrap_or_default().to_string_lossy();
+        let default = Path::new(parent).join(format!("{stem}{suffix}"));
+        let dir = margemu::rundir::prepare(self.output.as_deref(), &default, self.force)?;
+        Ok(dir)
+    }
+}
+
+/// Calls `handler` on SIGINT, SIGTERM and SIGHUP (once installed, for the rest of the process).
+pub fn on_signal(handler: impl FnMut() + Send + 'static) -> Result<()> {
+    ctrlc::set_handler(handler).context("installing the SIGINT/SIGTERM/SIGHUP handler")
+}
+
 /// Every subcommand.
 #[derive(clap::Subcommand)]
 pub enum Command {
     /// Inspect scene files.
     #[command(subcommand)]
     Scene(scene::Cmd),
-    /// Stream a scene to the firmware's link handler behind a pseudo-terminal pair (no hardware).
+    /// Stream a scene to the firmware's link handler behind a pseudo-terminal pair (no hardware);
+    /// the session goes to sessions/<scene name>-loopback (numbered if taken) unless -o.
     Loopback(loopback::Cmd),
-    /// Simulate a scene and write its run directory (truth.csv, meta.toml).
+    /// Simulate a scene and write its run directory (truth.csv, marg.csv, meta.toml) to
+    /// runs/<scene name> (numbered if taken) unless -o.
     Simulate(simulate::Cmd),
     /// Analyse recorded columns (noise: Allan deviation and PSD).
     #[command(subcommand)]
@@ -31,7 +65,8 @@ pub enum Command {
     /// Measure speed against error on this machine.
     #[command(subcommand)]
     Bench(bench::Cmd),
-    /// Stream a scene to a device in real time over a serial port and log the session.
+    /// Stream a scene to a device in real time over a serial port and log the session to
+    /// sessions/<scene name> (numbered if taken) unless -o.
     Stream(stream::Cmd),
     /// List serial ports.
     Ports(ports::Cmd),

@@ -21,9 +21,9 @@ pub struct Cmd {
     /// Line rate (ignored by USB CDC and pseudo-terminals).
     #[arg(long, default_value_t = 921_600)]
     baud: u32,
-    /// Session directory (default: sessions/<scene name>).
-    #[arg(short, long)]
-    output: Option<PathBuf>,
+    // Default: sessions/<scene name>.
+    #[command(flatten)]
+    output: super::OutputArgs,
     /// Write each batch this many milliseconds before its first sample's instant (at most 3/8
     /// of the device's buffer).
     #[arg(long, default_value_t = 200.0)]
@@ -137,10 +137,6 @@ impl SourceArgs {
 impl Cmd {
     pub fn run(self) -> Result<()> {
         let scene = self.chip.apply(Scene::load(&self.scene)?)?;
-        let dir = self.output.clone().unwrap_or_else(|| {
-            let stem = self.scene.file_stem().unwrap_or_default();
-            PathBuf::from("sessions").join(stem)
-        });
         let mut images = margemu::stream::ImageSettings::for_scene(&scene);
         if let Some(v) = self.mag_ut_per_unit {
             anyhow::ensure!(v.is_finite() && v > 0.0, "--mag-ut-per-unit must be > 0");
@@ -163,6 +159,7 @@ impl Cmd {
         };
         let port =
             open_port(&self.port, self.baud).with_context(|| format!("opening {}", self.port))?;
+        let dir = self.output.prepare(&self.scene, "sessions", "")?;
         let mut session = prepare(&scene, config, &dir)?;
         let dut = self.dut.attach(&mut session, &dir)?;
         let streamed = stream_to(&scene, session, &dir, port, &self.port);
@@ -206,8 +203,7 @@ pub fn stream_to(
 ) -> Result<margemu::stream::Summary> {
     eprintln!("image settings: {:?}", session.image_settings());
     let stop = session.stop_flag();
-    ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
-        .context("installing the Ctrl-C handler")?;
+    super::on_signal(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))?;
     let bar = ProgressBar::new(session.samples().len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),

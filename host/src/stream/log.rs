@@ -15,7 +15,11 @@
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before`: each write of the device under test (`bus` spi, i2c or aux; `dropped_before`: writes the device lost just before this batch) |
-//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`) |
+//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
+//!
+//! `meta.toml` ends with the `[completion]` table (status, samples written, why the session
+//! ended; [`crate::rundir`]), written once every file is closed: after the session, or after
+//! the device under test's reader when one is attached.
 
 use crate::output::TruthWriter;
 use crate::truth::Truth;
@@ -26,6 +30,17 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use super::images::image_hex;
+
+/// The files of a session besides `meta.toml`.
+pub const SESSION_FILES: [&str; 7] = [
+    "truth.csv",
+    "sent.csv",
+    "served.csv",
+    "device.csv",
+    "telemetry.csv",
+    "register_writes.csv",
+    "events.csv",
+];
 
 /// Header of `sent.csv` in source mode images.
 pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image,resend";
@@ -68,7 +83,7 @@ impl SessionLog {
     /// source mode's), and writes `meta.toml`.
     pub fn create(dir: &Path, meta: &str, sent_columns: &str) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
-        std::fs::write(dir.join("meta.toml"), meta)?;
+        crate::rundir::write_meta(dir, meta)?;
         let mut log = Self {
             dir: dir.to_path_buf(),
             float: ryu::Buffer::new(),
