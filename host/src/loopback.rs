@@ -50,6 +50,12 @@ pub struct LoopbackDevice {
 }
 
 impl LoopbackDevice {
+    /// Whether the device loop has ended by itself (the port closed or failed, or the hook
+    /// ended it).
+    pub fn has_ended(&self) -> bool {
+        self.thread.is_finished()
+    }
+
     /// Stops the device loop and returns its report.
     pub fn stop(self) -> DeviceReport {
         self.stop.store(true, Ordering::Relaxed);
