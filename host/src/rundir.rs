@@ -7,8 +7,9 @@
 //!   command run twice writes two directories, and the second run never mixes with the first;
 //! - an explicit directory (`-o DIR`) that exists and is not empty is refused, unless `force`:
 //!   then margemu's own files in it ([`is_own_file`]: the names its writers define, and their
-//!   `.partial` forms) are removed first. Anything else in it (a subdirectory, a file margemu
-//!   does not write) is left alone and the directory refused, naming what is there.
+//!   `.partial` forms), and subdirectories holding only such files (`demo`'s sessions), are
+//!   removed first. Anything else in it (a file margemu does not write, a subdirectory holding
+//!   one) is left alone and the directory refused, naming what is there.
 //!
 //! **Completion record**: `meta.toml` is written (whole, under a temporary name, then renamed)
 //! when a run begins, and a `[completion]` table ([`Completion`]) is appended to it when the run
@@ -156,6 +157,7 @@ pub fn is_own_file(name: &str) -> bool {
             crate::stream::log::SESSION_FILES.as_slice(),
             crate::dut::log::FILES.as_slice(),
             crate::evaluate::report::FILES.as_slice(),
+            [crate::demo::table::FILE].as_slice(),
         ]
         .iter()
         .any(|files| files.contains(&name))
@@ -228,22 +230,48 @@ fn entries(dir: &Path) -> io::Result<Vec<(String, bool)>> {
     Ok(names)
 }
 
-/// Removes margemu's own files from `dir`, after checking nothing else is there.
-fn clear_own(dir: &Path, entries: Vec<(String, bool)>) -> Result<(), RunDirError> {
-    let foreign: Vec<&str> = entries
+/// Whether the entry `name` of `dir` is margemu's own: one of its files, or a directory of
+/// its files only (a session of `demo`).
+fn is_own_entry(dir: &Path, name: &str, is_file: bool) -> io::Result<bool> {
+    if is_file {
+        return Ok(is_own_file(name));
+    }
+    let sub = dir.join(name);
+    if !sub.is_dir() || sub.is_symlink() {
+        return Ok(false);
+    }
+    Ok(entries(&sub)?
         .iter()
-        .filter(|(name, is_file)| !(*is_file && is_own_file(name)))
-        .map(|(name, _)| name.as_str())
-        .collect();
+        .all(|(name, is_file)| *is_file && is_own_file(name)))
+}
+
+/// Removes margemu's own files (and directories of them) from `dir`, after checking nothing
+/// else is there.
+fn clear_own(dir: &Path, entries: Vec<(String, bool)>) -> Result<(), RunDirError> {
+    let io_err = |path: PathBuf| move |source| RunDirError::Io { path, source };
+    let mut foreign = Vec::new();
+    for (name, is_file) in &entries {
+        if !is_own_entry(dir, name, *is_file).map_err(io_err(dir.join(name)))? {
+            foreign.push(name.as_str());
+        }
+    }
     if !foreign.is_empty() {
         return Err(RunDirError::Foreign {
             path: dir.to_path_buf(),
             entries: foreign.join(", "),
         });
     }
-    for (name, _) in &entries {
+    for (name, is_file) in &entries {
         let path = dir.join(name);
-        std::fs::remove_file(&path).map_err(|source| RunDirError::Io { path, source })?;
+        if *is_file {
+            std::fs::remove_file(&path).map_err(io_err(path))?;
+        } else {
+            for (inner, _) in self::entries(&path).map_err(io_err(path.clone()))? {
+                let file = path.join(inner);
+                std::fs::remove_file(&file).map_err(io_err(file))?;
+            }
+            std::fs::remove_dir(&path).map_err(io_err(path))?;
+        }
     }
     Ok(())
 }
@@ -426,11 +454,19 @@ mod tests {
         assert!(matches!(e, RunDirError::NotEmpty { .. }), "{e}");
         assert_eq!(prepare(Some(&dir), Path::new("unused"), true).unwrap(), dir);
         assert!(entries(&dir).unwrap().is_empty());
+        std::fs::create_dir_all(dir.join("ecf-initial")).unwrap();
+        std::fs::write(dir.join("ecf-initial/report.md"), "x").unwrap();
+        std::fs::write(dir.join("table3.md"), "x").unwrap();
+        assert_eq!(prepare(Some(&dir), Path::new("unused"), true).unwrap(), dir);
+        assert!(entries(&dir).unwrap().is_empty());
+        std::fs::create_dir_all(dir.join("photos")).unwrap();
+        std::fs::write(dir.join("photos/bench.jpg"), "x").unwrap();
         std::fs::write(dir.join("notes.txt"), "mine").unwrap();
         std::fs::write(dir.join("truth.csv"), "x").unwrap();
         let e = prepare(Some(&dir), Path::new("unused"), true).unwrap_err();
-        assert!(e.to_string().contains("notes.txt"), "{e}");
+        assert!(e.to_string().contains("(notes.txt, photos)"), "{e}");
         assert!(dir.join("notes.txt").exists() && dir.join("truth.csv").exists());
+        assert!(dir.join("photos/bench.jpg").exists());
     }
 
     #[test]

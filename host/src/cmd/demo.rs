@@ -18,10 +18,10 @@ pub struct Cmd {
     /// The scene (default: the paper's case study).
     #[arg(long, default_value = "hil-fixtures/scenes/case-study.toml")]
     scene: PathBuf,
-    /// Output directory: one session per run (`<filter>-<initial|tuned>/`, with report.md and
-    /// figures) and table3.md.
-    #[arg(short, long, default_value = "demo")]
-    output: PathBuf,
+    // One session per run (`<filter>-<initial|tuned>/`, with report.md and figures) and
+    // table3.md; default: demo/, numbered if taken.
+    #[command(flatten)]
+    output: super::OutputArgs,
     /// Shorten the scene to this many seconds (each run streams in real time).
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
@@ -98,6 +98,7 @@ impl Cmd {
             }
             scene = demo::shorten(&scene, seconds)?;
         }
+        let out = self.output.prepare_or(Path::new("demo"))?;
         let mut tuned = match &self.tuned {
             Some(path) => from_file(path)?,
             None => from_tuner(self.seeds, self.max_evals),
@@ -119,7 +120,7 @@ impl Cmd {
         );
         let options = DemoOptions {
             scene,
-            out: self.output.clone(),
+            out: out.clone(),
             filters: self.filters.clone(),
             plots: !self.no_plots,
         };
@@ -157,7 +158,7 @@ impl Cmd {
                 println!("{line}");
             }
         }
-        let md = self.output.join("table3.md");
+        let md = out.join(table::FILE);
         std::fs::write(&md, table::render(&runs, true))
             .with_context(|| format!("writing {}", md.display()))?;
         println!("wrote {}", md.display());

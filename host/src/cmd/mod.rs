@@ -36,9 +36,16 @@ impl OutputArgs {
     /// fresh.
     pub fn prepare(&self, scene: &Path, parent: &str, suffix: &str) -> Result<PathBuf> {
         let stem = scene.file_stem().unwrap_or_default().to_string_lossy();
-        let default = Path::new(parent).join(format!("{stem}{suffix}"));
-        let dir = margemu::rundir::prepare(self.output.as_deref(), &default, self.force)?;
-        Ok(dir)
+        self.prepare_or(&Path::new(parent).join(format!("{stem}{suffix}")))
+    }
+
+    /// The directory, created and empty: --output, or `default` made fresh.
+    pub fn prepare_or(&self, default: &Path) -> Result<PathBuf> {
+        Ok(margemu::rundir::prepare(
+            self.output.as_deref(),
+            default,
+            self.force,
+        )?)
     }
 }
 
@@ -74,7 +81,8 @@ pub enum Command {
     Chips(chips::Cmd),
     /// Score a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned.
     Evaluate(evaluate::Cmd),
-    /// The paper's case study through loopback with the virtual flight controller: Table 3.
+    /// The paper's case study through loopback with the virtual flight controller: Table 3
+    /// (written to demo/, numbered if taken, unless -o).
     Demo(demo::Cmd),
     /// Run a reference filter (ECF, GDA, EKF) offline over a recording; write its estimates.
     Filter(filter::Cmd),
