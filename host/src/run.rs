@@ -139,8 +139,9 @@ fn write_err(path: &Path) -> impl FnOnce(std::io::Error) -> RunError {
     move |source| RunError::Write { path, source }
 }
 
-/// The CSV files of [`simulate_to_dir`], renamed to their final names whatever the outcome
-/// (every row written so far is whole); `written` counts the samples written.
+/// The CSV files of [`simulate_to_dir`], renamed to their final names once the sample loop
+/// has ended, however it ended (interrupted: whole rows up to the stop; a write error: what
+/// reached the disk); `written` counts the samples written.
 fn write_files(
     scene: &Scene,
     dir: &Path,

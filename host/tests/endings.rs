@@ -135,3 +135,32 @@ fn the_loopback_device_reports_stopped_when_the_host_hangs_up_after_stop() {
     }
     assert_eq!(device.stop().ended, "stopped");
 }
+
+#[test]
+fn sigterm_as_soon_as_the_directory_exists_still_ends_with_a_record() {
+    // The handler is installed before the directory is made, so a signal while the session's
+    // images are still being predicted ends the session as interrupted too.
+    let work = scratch("sigterm-early");
+    let scene = long_scene(&work, 60.0);
+    let dir = work.join("session");
+    let args: Vec<&OsStr> = vec![
+        "loopback".as_ref(),
+        scene.as_os_str(),
+        "-o".as_ref(),
+        dir.as_os_str(),
+    ];
+    let mut child = spawn_margemu(&args, &work);
+    wait_until(&mut child, "the session directory", || dir.is_dir());
+    send_signal(&child, "TERM");
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let record = completion(&dir).expect("a completion record");
+    assert_eq!(record.status, Status::Interrupted, "{record:?}");
+    let (_, events) = common::read_csv(&dir, "events.csv");
+    assert_eq!(events.last().unwrap()[1], "end", "{events:?}");
+}

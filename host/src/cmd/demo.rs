@@ -10,8 +10,6 @@ use margemu::scene::Scene;
 use margemu::tune::{self as tuner, Dataset, TuneOptions};
 use margemu::vfc::describe;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 #[derive(clap::Args)]
 pub struct Cmd {
@@ -91,6 +89,7 @@ fn from_tuner(seeds: usize, max_evals: usize) -> Box<demo::Tuned<'static>> {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
+        let interrupt = super::Interrupt::install()?;
         let mut scene = Scene::load(&self.scene)?;
         if let Some(seconds) = self.duration {
             if !(seconds.is_finite() && seconds > 0.0) {
@@ -103,9 +102,7 @@ impl Cmd {
             Some(path) => from_file(path)?,
             None => from_tuner(self.seeds, self.max_evals),
         };
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = stop.clone();
-        super::on_signal(move || flag.store(true, Ordering::Relaxed))?;
+        let stop = interrupt.flag();
         let (over, n, max) = demo::gyro_clipping(&scene)?;
         println!(
             "demo: {} ({} s at {} Hz) through loopback with the virtual flight controller: {} run(s) in real time",

@@ -32,6 +32,7 @@ pub struct Cmd {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
+        let interrupt = super::Interrupt::install()?;
         let scene = self.chip.apply(Scene::load(&self.scene)?)?;
         let vfc = self.vfc.config(&scene)?;
         let settings = match vfc {
@@ -50,6 +51,7 @@ impl Cmd {
             ..StreamConfig::default()
         };
         let mut session = prepare(&scene, config, &dir)?;
+        interrupt.watch(session.stop_flag());
         let (device, dut) = match vfc {
             Some(cfg) => {
                 let expected = settings.chip;

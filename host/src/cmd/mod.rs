@@ -2,6 +2,8 @@
 
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 
 pub mod analyze;
 pub mod bench;
@@ -49,9 +51,49 @@ impl OutputArgs {
     }
 }
 
-/// Calls `handler` on SIGINT, SIGTERM and SIGHUP (once installed, for the rest of the process).
-pub fn on_signal(handler: impl FnMut() + Send + 'static) -> Result<()> {
-    ctrlc::set_handler(handler).context("installing the SIGINT/SIGTERM/SIGHUP handler")
+/// SIGINT, SIGTERM and SIGHUP, caught from the start of a command: each sets every stop flag
+/// handed to [`Interrupt::watch`], including flags handed over after the signal came (a session
+/// whose images were still being predicted then starts stopped, and ends as interrupted).
+#[derive(Clone)]
+pub struct Interrupt(Arc<Mutex<Signalled>>);
+
+#[derive(Default)]
+struct Signalled {
+    fired: bool,
+    flags: Vec<Arc<AtomicBool>>,
+}
+
+impl Interrupt {
+    /// Installs the handler (once per process).
+    pub fn install() -> Result<Self> {
+        let this = Self(Arc::default());
+        let shared = this.0.clone();
+        ctrlc::set_handler(move || {
+            let mut s = shared.lock().unwrap_or_else(|e| e.into_inner());
+            s.fired = true;
+            s.flags
+                .iter()
+                .for_each(|f| f.store(true, Ordering::Relaxed));
+        })
+        .context("installing the SIGINT/SIGTERM/SIGHUP handler")?;
+        Ok(this)
+    }
+
+    /// Sets `flag` on a signal (at once if one has come).
+    pub fn watch(&self, flag: Arc<AtomicBool>) {
+        let mut s = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if s.fired {
+            flag.store(true, Ordering::Relaxed);
+        }
+        s.flags.push(flag);
+    }
+
+    /// A new flag, set on a signal.
+    pub fn flag(&self) -> Arc<AtomicBool> {
+        let flag = Arc::new(AtomicBool::new(false));
+        self.watch(flag.clone());
+        flag
+    }
 }
 
 /// Every subcommand.

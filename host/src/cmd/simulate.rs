@@ -5,8 +5,6 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use margemu::scene::Scene;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 use super::OutputArgs;
 use std::time::{Duration, Instant};
@@ -22,11 +20,9 @@ pub struct Cmd {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
+        let stop = super::Interrupt::install()?.flag();
         let scene = Scene::load(&self.scene)?;
         let dir = self.output.prepare(&self.scene, "runs", "")?;
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = stop.clone();
-        super::on_signal(move || flag.store(true, Ordering::Relaxed))?;
         let bar =
             ProgressBar::with_draw_target(Some(scene.samples()), ProgressDrawTarget::hidden());
         bar.set_style(

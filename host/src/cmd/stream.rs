@@ -136,6 +136,7 @@ impl SourceArgs {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
+        let interrupt = super::Interrupt::install()?;
         let scene = self.chip.apply(Scene::load(&self.scene)?)?;
         let mut images = margemu::stream::ImageSettings::for_scene(&scene);
         if let Some(v) = self.mag_ut_per_unit {
@@ -161,6 +162,7 @@ impl Cmd {
             open_port(&self.port, self.baud).with_context(|| format!("opening {}", self.port))?;
         let dir = self.output.prepare(&self.scene, "sessions", "")?;
         let mut session = prepare(&scene, config, &dir)?;
+        interrupt.watch(session.stop_flag());
         let dut = self.dut.attach(&mut session, &dir)?;
         let streamed = stream_to(&scene, session, &dir, port, &self.port);
         let dut = dut.map(finish_dut).transpose();
@@ -193,7 +195,8 @@ pub fn prepare(scene: &Scene, config: StreamConfig, dir: &std::path::Path) -> Re
 }
 
 /// Runs `session` of `scene` over `port` (named `label` in messages) with a progress line,
-/// prints the summary, and returns it; the session directory is `dir`.
+/// prints the summary, and returns it; the session directory is `dir`. The caller hands the
+/// session's stop flag to its [`super::Interrupt`].
 pub fn stream_to(
     scene: &Scene,
     session: Session,
@@ -202,8 +205,6 @@ pub fn stream_to(
     label: &str,
 ) -> Result<margemu::stream::Summary> {
     eprintln!("image settings: {:?}", session.image_settings());
-    let stop = session.stop_flag();
-    super::on_signal(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))?;
     let bar = ProgressBar::new(session.samples().len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),
