@@ -177,7 +177,7 @@ pub fn markdown(eval: &Evaluation, dir: &Path, figures: &[PathBuf]) -> String {
     md
 }
 
-/// Every file [`write`] may write.
+/// Every file [`write()`] may write.
 pub const FILES: [&str; 6] = [
     "errors.csv",
     "report.md",
