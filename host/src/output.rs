@@ -24,7 +24,10 @@ use std::io::{self, Write};
 
 /// The files `simulate` writes besides `meta.toml` (`perturbation.csv` only for scenes with a
 /// perturbation).
-pub const RUN_FILES: [&str; 3] = ["truth.csv", "marg.csv", "perturbation.csv"];
+pub const RUN_FILES: [&str; 3] = [TRUTH_FILE, "marg.csv", "perturbation.csv"];
+
+/// The ground truth's file, in run and session directories.
+pub const TRUTH_FILE: &str = "truth.csv";
 
 /// Header of `truth.csv`.
 pub const TRUTH_COLUMNS: [&str; 32] = [

@@ -25,7 +25,7 @@ mod vfc;
 pub struct OutputArgs {
     /// The directory to write (created if missing). Without it, a fresh directory is made
     /// under the default name, numbered (-2, -3, ...) if that one is taken.
-    #[arg(short, long)]
+    #[arg(short, long, value_name = "DIR")]
     output: Option<PathBuf>,
     /// Write into a non-empty --output directory: margemu's own files in it are removed first
     /// (anything else there makes the command refuse).

@@ -21,7 +21,7 @@
 //! ended; [`crate::rundir`]), written once every file is closed: after the session, or after
 //! the device under test's reader when one is attached.
 
-use crate::output::TruthWriter;
+use crate::output::{TruthWriter, TRUTH_FILE};
 use crate::truth::Truth;
 use margemu_model::sensor;
 use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
@@ -31,15 +31,28 @@ use std::path::{Path, PathBuf};
 
 use super::images::image_hex;
 
+/// `sent.csv`.
+pub const SENT_FILE: &str = "sent.csv";
+/// `served.csv`.
+pub const SERVED_FILE: &str = "served.csv";
+/// `device.csv`.
+pub const DEVICE_FILE: &str = "device.csv";
+/// `telemetry.csv`.
+pub const TELEMETRY_FILE: &str = "telemetry.csv";
+/// `register_writes.csv`.
+pub const REGISTER_WRITES_FILE: &str = "register_writes.csv";
+/// `events.csv`.
+pub const EVENTS_FILE: &str = "events.csv";
+
 /// The files of a session besides `meta.toml`.
 pub const SESSION_FILES: [&str; 7] = [
-    "truth.csv",
-    "sent.csv",
-    "served.csv",
-    "device.csv",
-    "telemetry.csv",
-    "register_writes.csv",
-    "events.csv",
+    TRUTH_FILE,
+    SENT_FILE,
+    SERVED_FILE,
+    DEVICE_FILE,
+    TELEMETRY_FILE,
+    REGISTER_WRITES_FILE,
+    EVENTS_FILE,
 ];
 
 /// Header of `sent.csv` in source mode images.
@@ -87,12 +100,12 @@ impl SessionLog {
         let mut log = Self {
             dir: dir.to_path_buf(),
             float: ryu::Buffer::new(),
-            sent: create(dir, "sent.csv", sent_columns)?,
-            served: create(dir, "served.csv", SERVED_COLUMNS)?,
-            device: create(dir, "device.csv", DEVICE_COLUMNS)?,
-            telemetry: create(dir, "telemetry.csv", TELEMETRY_COLUMNS)?,
-            register_writes: create(dir, "register_writes.csv", REGISTER_WRITES_COLUMNS)?,
-            events: create(dir, "events.csv", EVENTS_COLUMNS)?,
+            sent: create(dir, SENT_FILE, sent_columns)?,
+            served: create(dir, SERVED_FILE, SERVED_COLUMNS)?,
+            device: create(dir, DEVICE_FILE, DEVICE_COLUMNS)?,
+            telemetry: create(dir, TELEMETRY_FILE, TELEMETRY_COLUMNS)?,
+            register_writes: create(dir, REGISTER_WRITES_FILE, REGISTER_WRITES_COLUMNS)?,
+            events: create(dir, EVENTS_FILE, EVENTS_COLUMNS)?,
         };
         log.flush()?;
         Ok(log)
@@ -107,13 +120,13 @@ impl SessionLog {
     pub fn append_meta(&mut self, text: &str) -> io::Result<()> {
         let mut meta = std::fs::OpenOptions::new()
             .append(true)
-            .open(self.dir.join("meta.toml"))?;
+            .open(self.dir.join(crate::rundir::META_FILE))?;
         meta.write_all(text.as_bytes())
     }
 
     /// Writes `truth.csv` in one go.
     pub fn write_truth<'a>(&self, truths: impl Iterator<Item = &'a Truth>) -> io::Result<()> {
-        let file = BufWriter::with_capacity(1 << 20, File::create(self.dir.join("truth.csv"))?);
+        let file = BufWriter::with_capacity(1 << 20, File::create(self.dir.join(TRUTH_FILE))?);
         let mut out = TruthWriter::new(file)?;
         for t in truths {
             out.write(t)?;

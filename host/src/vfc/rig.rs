@@ -207,11 +207,15 @@ impl AttachedDut {
             source,
         };
         append(
-            &self.dir.join("events.csv"),
+            &self.dir.join(crate::stream::log::EVENTS_FILE),
             &format!("{host_ns},dut,{detail}\n"),
         )
         .map_err(log_err)?;
-        append(&self.dir.join("meta.toml"), &summary.meta_toml()).map_err(log_err)?;
+        append(
+            &self.dir.join(crate::rundir::META_FILE),
+            &summary.meta_toml(),
+        )
+        .map_err(log_err)?;
         completion
             .map_or(Ok(()), CompletionRecord::release)
             .map_err(log_err)?;
