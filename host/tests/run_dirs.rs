@@ -274,3 +274,34 @@ fn evaluate_scores_an_interrupted_run_only_when_allowed_and_says_so() {
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(report.contains("INCOMPLETE RUN"));
 }
+
+#[test]
+fn a_run_that_cannot_write_its_files_records_that_it_failed() {
+    // A directory where `marg.csv.partial` must go stands in for a full disk: the file cannot
+    // be created, and the record says why.
+    let dir = scratch("write-fails");
+    std::fs::create_dir_all(dir.join("marg.csv.partial")).unwrap();
+    let scene = margemu::scene::Scene::load(&fixture("figure3")).unwrap();
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let e = margemu::run::simulate_to_dir(&scene, &dir, &stop, |_, _| {}).unwrap_err();
+    let record = completion(&dir).expect("a completion record");
+    assert_eq!(record.status, Status::Failed);
+    assert_eq!(record.samples_written, 0);
+    assert_eq!(record.ended, e.to_string());
+    assert!(
+        record.ended.contains("marg.csv.partial"),
+        "{}",
+        record.ended
+    );
+    let truth = dir.join("truth.csv");
+    assert_refused_as_incomplete(
+        &dir,
+        &[
+            "evaluate".as_ref(),
+            dir.as_os_str(),
+            "--estimates".as_ref(),
+            truth.as_os_str(),
+        ],
+        "failed, 0 samples written of 3000",
+    );
+}
