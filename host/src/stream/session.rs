@@ -213,23 +213,21 @@ impl Session {
         let summary = run.summary();
         drop(run);
         shutdown.store(true, Ordering::Relaxed);
-        let (status, detail) = match &result {
+        let (status, ended) = match &result {
             Ok(()) => (Status::Complete, "completed".to_string()),
-            Err(StreamError::Interrupted) => (
-                Status::Interrupted,
-                format!("error: {}", StreamError::Interrupted),
-            ),
-            Err(e) => (Status::Failed, format!("error: {e}")),
+            Err(e @ StreamError::Interrupted) => (Status::Interrupted, e.to_string()),
+            Err(e) => (Status::Failed, e.to_string()),
+        };
+        let detail = match status {
+            Status::Complete => ended.clone(),
+            _ => format!("error: {ended}"),
         };
         let served = &summary.served;
         let completion = Completion {
             status,
             samples_written: served.samples - served.unreported,
             samples_expected: Some(served.samples),
-            ended: detail
-                .strip_prefix("error: ")
-                .unwrap_or(&detail)
-                .to_string(),
+            ended,
         };
         let logged = self
             .log

@@ -210,11 +210,17 @@ impl AttachedDut {
             &self.dir.join(crate::stream::log::EVENTS_FILE),
             &format!("{host_ns},dut,{detail}\n"),
         )
-        .map_err(log_err)?;
-        append(
-            &self.dir.join(crate::rundir::META_FILE),
-            &summary.meta_toml(),
-        )
+        .and_then(|()| {
+            append(
+                &self.dir.join(crate::rundir::META_FILE),
+                &summary.meta_toml(),
+            )
+        })
+        .inspect_err(|e| {
+            fail(format!(
+                "cannot record the device under test's summary: {e}"
+            ))
+        })
         .map_err(log_err)?;
         completion
             .map_or(Ok(()), CompletionRecord::release)
