@@ -12,6 +12,7 @@
 //! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
 //! - [`guard`]: the run stops at the first truth or sample value that is not finite;
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
+//! - [`rundir`]: which directory a run writes to, and the completion record written last;
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
 //! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
@@ -42,6 +43,7 @@ pub mod output;
 pub mod perf;
 pub mod reference;
 pub mod run;
+pub mod rundir;
 pub mod scene;
 pub mod stream;
 pub mod truth;

@@ -177,6 +177,16 @@ pub fn markdown(eval: &Evaluation, dir: &Path, figures: &[PathBuf]) -> String {
     md
 }
 
+/// Every file [`write()`] may write.
+pub const FILES: [&str; 6] = [
+    "errors.csv",
+    "report.md",
+    "attitude.png",
+    "attitude.svg",
+    "alignment.png",
+    "alignment.svg",
+];
+
 /// Writes `errors.csv`, the figures and `report.md` into `dir`; returns the files written.
 pub fn write(eval: &Evaluation, dir: &Path, plots: bool) -> Result<Vec<PathBuf>, EvalError> {
     let write_err = |path: &Path| {

@@ -56,6 +56,9 @@ pub struct EvalOptions {
     pub device_time: bool,
     /// Phase thresholds.
     pub rules: PhaseRules,
+    /// Score a run directory whose completion record is missing or not `complete`
+    /// ([`crate::rundir::check_complete`]), with a note saying so, instead of refusing it.
+    pub allow_incomplete: bool,
 }
 
 impl Default for EvalOptions {
@@ -66,6 +69,7 @@ impl Default for EvalOptions {
             message: None,
             device_time: true,
             rules: PhaseRules::default(),
+            allow_incomplete: false,
         }
     }
 }
@@ -94,6 +98,8 @@ pub enum EvalError {
     },
     /// {0}
     Plot(crate::analysis::plot::PlotError),
+    /// {0}
+    RunDir(#[from] crate::rundir::RunDirError),
     /// {path}: cannot write: {error}
     Write {
         /// The file.
@@ -178,7 +184,14 @@ pub struct Evaluation {
 
 /// Runs one evaluation (see the module docs).
 pub fn evaluate(source: &Source, options: &EvalOptions) -> Result<Evaluation, EvalError> {
-    let loaded = super::load::load(source, options)?;
+    let incomplete = match source {
+        Source::Session(dir) | Source::Estimates { dir, .. } => {
+            crate::rundir::check_complete(dir, options.allow_incomplete)?
+        }
+        Source::External { .. } => None,
+    };
+    let mut loaded = super::load::load(source, options)?;
+    loaded.notes.extend(incomplete);
     let context = || loaded.inputs.join(", ");
     let scored = |reason| EvalError::Score {
         context: context(),
