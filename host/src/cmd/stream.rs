@@ -208,7 +208,7 @@ pub fn stream_to(
     let stop = session.stop_flag();
     ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
         .context("installing the Ctrl-C handler")?;
-    let bar = ProgressBar::new(session.samples().len() as u64);
+    let bar = ProgressBar::new(session.sample_count());
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),
     );

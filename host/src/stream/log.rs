@@ -9,7 +9,7 @@
 //!
 //! | file | columns |
 //! |---|---|
-//! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample of the scene |
+//! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample, written as the session predicts them (in order, a window ahead of what it sends): every sample of the scene once the session completes |
 //! | `sent.csv` | one row per item written, in the order written. Source images: `index,t_ns,send_ns,late_ns,image,resend`: sample index, its latch instant, when the write of its batch to the port completed, how late that was against the batch's schedule `start_host_ns + t_ns − lead` of its first sample (empty for the prefill, written before Start, and for resends), the 22-byte register image as 44 lowercase hex digits, and `1` if the item was written again because the device had not received it (go-back-N; `0` for the first copy). Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend`: the kinematics sample's index and instant at the kinematics rate, the same times, the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip, and the resend flag |
 //! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
@@ -55,6 +55,7 @@ pub struct SessionLog {
     telemetry: BufWriter<File>,
     register_writes: BufWriter<File>,
     events: BufWriter<File>,
+    truth: TruthWriter<BufWriter<File>>,
 }
 
 fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
@@ -64,7 +65,7 @@ fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
 }
 
 impl SessionLog {
-    /// Creates `dir` and every file but `truth.csv`, with their headers (`sent_columns`: the
+    /// Creates `dir` and every file, with their headers (`sent_columns`: the
     /// source mode's), and writes `meta.toml`.
     pub fn create(dir: &Path, meta: &str, sent_columns: &str) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
@@ -78,6 +79,10 @@ impl SessionLog {
             telemetry: create(dir, "telemetry.csv", TELEMETRY_COLUMNS)?,
             register_writes: create(dir, "register_writes.csv", REGISTER_WRITES_COLUMNS)?,
             events: create(dir, "events.csv", EVENTS_COLUMNS)?,
+            truth: TruthWriter::new(BufWriter::with_capacity(
+                1 << 16,
+                File::create(dir.join("truth.csv"))?,
+            ))?,
         };
         log.flush()?;
         Ok(log)
@@ -96,14 +101,9 @@ impl SessionLog {
         meta.write_all(text.as_bytes())
     }
 
-    /// Writes `truth.csv` in one go.
-    pub fn write_truth<'a>(&self, truths: impl Iterator<Item = &'a Truth>) -> io::Result<()> {
-        let file = BufWriter::with_capacity(1 << 20, File::create(self.dir.join("truth.csv"))?);
-        let mut out = TruthWriter::new(file)?;
-        for t in truths {
-            out.write(t)?;
-        }
-        out.finish()?.flush()
+    /// Rows of `truth.csv`, in order.
+    pub fn truth(&mut self, truths: &[Truth]) -> io::Result<()> {
+        truths.iter().try_for_each(|t| self.truth.write(t))
     }
 
     /// One row of `sent.csv` in source mode images.
@@ -257,6 +257,7 @@ impl SessionLog {
         self.device.flush()?;
         self.telemetry.flush()?;
         self.register_writes.flush()?;
+        self.truth.flush()?;
         self.events.flush()
     }
 }
