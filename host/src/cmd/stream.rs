@@ -243,8 +243,8 @@ pub fn stream_to(
     );
     let s = summary.served;
     println!(
-        "served as predicted, byte for byte: {} of {} samples ({} underruns, {} mismatched, {} not reported; served.csv)",
-        s.byte_exact, s.samples, s.underruns, s.mismatched, s.unreported
+        "served as predicted, byte for byte: {} of {} samples ({} underruns, {} mismatched, {} not reported, {} unverifiable; served.csv)",
+        s.byte_exact, s.samples, s.underruns, s.mismatched, s.unreported, s.unverifiable
     );
     let j = summary.jitter;
     println!(

@@ -112,10 +112,9 @@ mod tests {
 
     #[test]
     fn items_come_in_order_and_an_error_comes_last() {
-        let all: Vec<_> =
-            Predictions::spawn(|emit| (0..1000u32).try_for_each(|i| emit(i)).or(Ok(())))
-                .collect::<Result<_, _>>()
-                .unwrap();
+        let all: Vec<_> = Predictions::spawn(|emit| (0..1000u32).try_for_each(emit).or(Ok(())))
+            .collect::<Result<_, _>>()
+            .unwrap();
         assert_eq!(all, (0..1000).collect::<Vec<_>>());
         let failing = Predictions::spawn(|emit| {
             let _ = emit(1u8);
