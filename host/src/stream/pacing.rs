@@ -18,12 +18,17 @@ use margemu_protocol::link::{DeviceState, Message, Start};
 use std::io::Write;
 use std::time::{Duration, Instant};
 
+/// Batches predicted beyond the next one to write.
+const PREDICT_AHEAD: u64 = 2;
+
 impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     /// Sets the batch size and the lead from the device's HelloAck (see the module docs), and
-    /// the windows of what the session keeps: the Served check's ([`served_window`]), the
-    /// write times of the last `buffer_capacity` items and a batch (a go-back starts no earlier
-    /// than the credit window, `limit − buffer_capacity`, and nothing was written at or beyond
-    /// `limit`), and the items themselves (one more batch, so a go-back always finds them).
+    /// the windows of what the session keeps: the write times of the last `buffer_capacity`
+    /// items and a batch (a go-back starts no earlier than the credit window, `limit −
+    /// buffer_capacity`, and nothing was written at or beyond `limit`); the items themselves,
+    /// predicted up to [`PREDICT_AHEAD`] batches beyond the next to write (so a go-back always
+    /// finds them); the Served check's ([`served_window`], those predicted ahead counted as
+    /// buffered).
     pub(super) fn plan_pacing(&mut self) {
         let (max_batch, capacity) = self.ack.map_or((1, 4), |a| {
             let c = a.capabilities;
@@ -43,12 +48,13 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             .sample_time_ns(3 * capacity as u64 / 8);
         self.batch = batch as u64;
         self.lead = self.session.config.lead.min(Duration::from_nanos(window));
-        let capacity = u32::try_from(capacity).unwrap_or(u32::MAX);
+        let ahead = PREDICT_AHEAD as usize * batch;
+        let buffered = u32::try_from(capacity.saturating_add(ahead)).unwrap_or(u32::MAX);
         let hold = u32::try_from(self.session.hold()).unwrap_or(u32::MAX);
-        self.served = ServedCheck::new(self.total(), served_window(capacity, hold));
-        let items = (capacity as usize).saturating_add(batch).min(MAX_WINDOW);
+        self.served = ServedCheck::new(self.total(), served_window(buffered, hold));
+        let items = capacity.saturating_add(batch).min(MAX_WINDOW);
         self.go_back = GoBackN::new(items);
-        self.session.prediction.items = Window::new(items + batch);
+        self.session.prediction.items = Window::new(items + ahead + batch);
     }
 
     /// The instant the batch starting at item `j` is due (`None` before Start).
@@ -137,6 +143,9 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     fn send_next(&mut self, stall: &mut Option<Instant>) -> Result<(), StreamError> {
         let total = self.session.stream_len();
         self.report(false);
+        // Predicted ahead while there is time, so a due batch never waits for its prediction.
+        let ahead = (self.next + PREDICT_AHEAD * self.batch).min(total);
+        self.session.predict_through(ahead, &mut self.served)?;
         let due = self.due(self.next).expect("started");
         let spin = self.session.config.spin;
         if Instant::now() + spin < due {

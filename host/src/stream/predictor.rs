@@ -13,8 +13,8 @@ use std::thread::JoinHandle;
 
 /// Items per chunk passed from the producer's thread.
 pub const CHUNK: usize = 256;
-/// Chunks that may wait unread.
-pub const DEPTH: usize = 4;
+/// Chunks that may wait unread (a second of a 4 kHz scene, about 1.2 MB).
+pub const DEPTH: usize = 16;
 
 /// The producer asked the run to stop: its reader is gone.
 pub(super) struct ReaderGone;
