@@ -74,6 +74,11 @@ impl<W: Write> TruthWriter<W> {
         self.out.write_all(b"\n")
     }
 
+    /// Flushes the inner writer.
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+
     /// Flushes and returns the inner writer.
     pub fn finish(mut self) -> io::Result<W> {
         self.out.flush()?;

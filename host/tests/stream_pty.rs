@@ -8,7 +8,7 @@ mod common;
 
 use common::{assert_logs_valid, config, read_csv, scene, scratch};
 use margemu::loopback::{spawn_device, spawn_device_with, Firmware};
-use margemu::stream::{parse_image_hex, Session, StreamConfig, StreamError};
+use margemu::stream::{parse_image_hex, predict_images, Session, StreamConfig, StreamError};
 use margemu_firmware::chip::SpiTarget;
 use margemu_firmware::link::{Device, Identity};
 use margemu_protocol::link::{
@@ -45,7 +45,9 @@ fn a_short_scene_streams_end_to_end_byte_for_byte() {
     })
     .unwrap();
     let session = Session::new(&scene, config(), &dir).unwrap();
-    let predicted: Vec<_> = session.samples().iter().map(|s| s.image).collect();
+    let predicted: Vec<_> = predict_images(&scene, session.image_settings())
+        .map(|s| s.unwrap().image)
+        .collect();
     let summary = session.run_on_port(host, |_| {}).unwrap();
     let report = device.stop();
     assert_eq!((summary.sent, summary.stream_len), (1000, 1000));

@@ -28,7 +28,7 @@ use std::io::Write;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use margemu::stream::{Session, StreamConfig};
+use margemu::stream::{predict_images, Session, StreamConfig};
 use margemu_protocol::link::{
     image_batch_wire_len, Encoder, Hello, Message, Telemetry, CRC32C, MAX_WIRE_LEN,
 };
@@ -141,10 +141,8 @@ fn images(elf: &Path, rate: u32, o: &Options) -> Row {
     };
     let batch = config.batch;
     let session = Session::new(&scene, config, &dir).expect("session");
-    let predicted: Vec<u32> = session
-        .samples()
-        .iter()
-        .map(|s| CRC32C.checksum(&s.image))
+    let predicted: Vec<u32> = predict_images(&scene, session.image_settings())
+        .map(|s| CRC32C.checksum(&s.expect("the scene's prediction").image))
         .collect();
     let t = Instant::now();
     let (qemu, uart0) = Qemu::boot(elf).expect("boot QEMU");

@@ -62,11 +62,17 @@ impl ModelStream {
         let prediction =
             predict_model(scene, &ImageSettings::for_scene(scene), Some(kinematics_hz))
                 .map_err(ModelStreamError::Stream)?;
+        let (mut kinematics, mut images) = (Vec::new(), Vec::new());
+        for s in prediction.samples {
+            let s = s.map_err(|e| ModelStreamError::Stream(e.into()))?;
+            kinematics.extend(s.kinematics);
+            images.push(s.sample.image);
+        }
         Ok(Self {
             out_rate,
             params: prediction.params,
-            kinematics: prediction.kinematics,
-            images: prediction.samples.into_iter().map(|s| s.image).collect(),
+            kinematics,
+            images,
             chip: scene.chip,
         })
     }

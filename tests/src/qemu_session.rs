@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use margemu::scene::Scene;
-use margemu::stream::{Session, StreamConfig, Summary};
+use margemu::stream::{predict_images, Session, StreamConfig, Summary};
 use margemu_protocol::link::{Configure, Telemetry, CRC32C};
 use serialport::SerialPort;
 
@@ -51,12 +51,10 @@ pub fn image_session(scene: &Scene, dir: &Path) -> Session {
     Session::new(scene, config, dir).unwrap_or_else(|e| panic!("session: {e}"))
 }
 
-/// The CRC-32C of every image `session` will send, in order.
-pub fn predicted_crcs(session: &Session) -> Vec<u32> {
-    session
-        .samples()
-        .iter()
-        .map(|s| CRC32C.checksum(&s.image))
+/// The CRC-32C of every image `session` will send for `scene`, in order.
+pub fn predicted_crcs(scene: &Scene, session: &Session) -> Vec<u32> {
+    predict_images(scene, session.image_settings())
+        .map(|s| CRC32C.checksum(&s.expect("the scene's prediction").image))
         .collect()
 }
 

@@ -25,6 +25,7 @@ use std::path::Path;
 use std::sync::Mutex;
 
 use margemu::scene::Scene;
+use margemu::stream::predict_images;
 use margemu_protocol::chip::ChipModel;
 use margemu_tests::model_source::ModelStream;
 use margemu_tests::motion_scene_text;
@@ -76,11 +77,9 @@ fn icm42688p_image_mode_serves_the_hosts_images_byte_for_byte() {
     let scene = icm_scene(IMAGE_RATE_HZ, 13);
     let dir = scratch("icm42688p-images");
     let session = image_session(&scene, &dir);
-    assert!(session
-        .samples()
-        .iter()
-        .all(|s| s.image.len() == ChipModel::Icm42688p.image_len()));
-    let predicted = predicted_crcs(&session);
+    assert!(predict_images(&scene, session.image_settings())
+        .all(|s| s.unwrap().image.len() == ChipModel::Icm42688p.image_len()));
+    let predicted = predicted_crcs(&scene, &session);
     let samples = (f64::from(IMAGE_RATE_HZ) * SECONDS) as usize;
     assert_eq!(predicted.len(), samples);
     // Noise on: no two consecutive predicted images are equal.

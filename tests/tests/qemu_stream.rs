@@ -37,7 +37,7 @@ fn session_streams_to_qemu_byte_for_byte() {
     let scene = motion_scene(RATE_HZ, SECONDS, 11);
     let dir = scratch("stream");
     let session = image_session(&scene, &dir);
-    let predicted = predicted_crcs(&session);
+    let predicted = predicted_crcs(&scene, &session);
     let samples = (f64::from(RATE_HZ) * SECONDS) as usize;
     assert_eq!(predicted.len(), samples);
 

@@ -89,8 +89,9 @@ impl Cmd {
         let overruns = summary.telemetry.map_or(0, |t| t.overruns);
         println!(
             "loopback: the device served {} samples ({} underruns, {overruns} overruns); \
-             {} of {} predicted images confirmed byte for byte ({} mismatched, {} not reported); device {}",
-            s.reported, s.underruns, s.byte_exact, s.samples, s.mismatched, s.unreported, report.ended
+             {} of {} predicted images confirmed byte for byte ({} mismatched, {} not reported, {} unverifiable); device {}",
+            s.reported, s.underruns, s.byte_exact, s.samples, s.mismatched, s.unreported,
+            s.unverifiable, report.ended
         );
         if let Some(k) = s.first_mismatch {
             bail!(

@@ -208,7 +208,7 @@ pub fn stream_to(
     label: &str,
 ) -> Result<margemu::stream::Summary> {
     eprintln!("image settings: {:?}", session.image_settings());
-    let bar = ProgressBar::new(session.samples().len() as u64);
+    let bar = ProgressBar::new(session.sample_count());
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),
     );
@@ -243,8 +243,8 @@ pub fn stream_to(
     );
     let s = summary.served;
     println!(
-        "served as predicted, byte for byte: {} of {} samples ({} underruns, {} mismatched, {} not reported; served.csv)",
-        s.byte_exact, s.samples, s.underruns, s.mismatched, s.unreported
+        "served as predicted, byte for byte: {} of {} samples ({} underruns, {} mismatched, {} not reported, {} unverifiable; served.csv)",
+        s.byte_exact, s.samples, s.underruns, s.mismatched, s.unreported, s.unverifiable
     );
     let j = summary.jitter;
     println!(

@@ -7,10 +7,8 @@ use super::resend::GoBackN;
 use super::rx::{self, RxEvent};
 use super::served::ServedCheck;
 use super::session::Session;
-use super::{JitterStats, LinkStats, Progress, StreamError, Summary};
-use margemu_protocol::link::{
-    Credit, Encoder, Hello, HelloAck, Message, RxStats, Telemetry, CRC32C,
-};
+use super::{Lateness, LinkStats, Progress, StreamError, Summary};
+use margemu_protocol::link::{Credit, Encoder, Hello, HelloAck, Message, RxStats, Telemetry};
 use margemu_protocol::PROTOCOL_VERSION;
 use std::io::Write;
 use std::sync::atomic::Ordering;
@@ -34,11 +32,12 @@ pub(super) struct Run<'s, W: Write, P: FnMut(&Progress)> {
     pub(super) ack: Option<HelloAck>,
     pub(super) telemetry: Option<Telemetry>,
     pub(super) host_rx: RxStats,
+    /// The Served reports against the prediction (its window set by [`Run::plan_pacing`]).
     pub(super) served: ServedCheck,
-    /// Lateness of each paced batch, ns.
-    pub(super) late: Vec<i64>,
-    /// Lateness of the same batches when their write completed, ns.
-    pub(super) written_late: Vec<i64>,
+    /// How late the paced batches' writes started.
+    pub(super) late: Lateness,
+    /// How late the same writes completed.
+    pub(super) written_late: Lateness,
     pub(super) max_late_ns: i64,
     pub(super) credit_stalls: u64,
     /// The next item to write.
@@ -48,7 +47,8 @@ pub(super) struct Run<'s, W: Write, P: FnMut(&Progress)> {
     pub(super) lead: Duration,
     /// Bytes written to the port: all, and those of sample batches with their item bytes.
     pub(super) link: LinkStats,
-    /// When each item was last written; the go-backs.
+    /// When each recent item was last written (its window set by [`Run::plan_pacing`]); the
+    /// go-backs.
     pub(super) go_back: GoBackN,
     /// Stop was written: reports no longer lead to resends.
     pub(super) stop_sent: bool,
@@ -65,10 +65,7 @@ impl<'s, W: Write, P: FnMut(&Progress)> Run<'s, W, P> {
         progress: P,
     ) -> Self {
         let origin = session.origin.unwrap_or_else(Instant::now);
-        let total = session.samples.len();
-        let go_back = GoBackN::new(session.stream_len());
-        let crcs = session.samples.iter().map(|s| CRC32C.checksum(&s.image));
-        let served = ServedCheck::new(crcs.collect());
+        let samples = session.samples;
         Self {
             session,
             writer,
@@ -82,16 +79,16 @@ impl<'s, W: Write, P: FnMut(&Progress)> Run<'s, W, P> {
             ack: None,
             telemetry: None,
             host_rx: RxStats::default(),
-            served,
-            late: Vec::with_capacity(total / 8 + 1),
-            written_late: Vec::with_capacity(total / 8 + 1),
+            served: ServedCheck::new(samples, 1),
+            late: Lateness::new(),
+            written_late: Lateness::new(),
             max_late_ns: 0,
             credit_stalls: 0,
             next: 0,
             batch: 1,
             lead: Duration::ZERO,
             link: LinkStats::default(),
-            go_back,
+            go_back: GoBackN::new(1),
             stop_sent: false,
             progress,
             last_progress: origin,
@@ -101,7 +98,7 @@ impl<'s, W: Write, P: FnMut(&Progress)> Run<'s, W, P> {
 
 impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     pub(super) fn total(&self) -> u64 {
-        self.session.samples.len() as u64
+        self.session.samples
     }
 
     pub(super) fn host_ns(&self, at: Instant) -> i64 {
@@ -283,7 +280,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             elapsed: self.start.map_or(Duration::ZERO, |s| s.elapsed()),
             telemetry: self.telemetry,
             host_rx: self.host_rx,
-            last_late_ns: self.late.last().copied().unwrap_or(0),
+            last_late_ns: self.late.last_ns(),
             max_late_ns: self.max_late_ns,
             served: self.served.stats(),
         }
@@ -297,8 +294,8 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             resent: self.go_back.resent(),
             dir: self.session.log.dir().to_path_buf(),
             start_host_ns: self.start.map(|s| self.host_ns(s)),
-            jitter: JitterStats::from_lateness(&self.late),
-            written_jitter: JitterStats::from_lateness(&self.written_late),
+            jitter: self.late.stats(),
+            written_jitter: self.written_late.stats(),
             telemetry: self.telemetry,
             device: self.ack,
             host_rx: self.host_rx,

@@ -1,4 +1,6 @@
-//! The host's prediction: every register image of a scene, computed before streaming.
+//! The host's prediction: the register image of every sample of a scene, computed in order
+//! as it is read ([`predict_images`]: a [`Predictions`] iterator, so a scene of any length
+//! takes the same memory).
 //!
 //! Per output sample `k`: truth, turned into the chip's axes by the scene's `[chip] rotation` →
 //! [`MargSim`] (the shared `model` crate, as `simulate` runs it) → physical units of the chip
@@ -8,17 +10,20 @@
 //!
 //! ```
 //! use margemu::scene::Scene;
-//! use margemu::stream::{predict, ImageSettings};
+//! use margemu::stream::{predict_images, ImageSettings};
 //! let scene = Scene::parse_str(
 //!     "duration = 0.01\nrate = 1000.0\nseed = 1\nmotion = \"static\"\n",
 //!     std::path::Path::new("inline.toml"),
 //! ).unwrap();
-//! let samples = predict(&scene, &ImageSettings::for_scene(&scene)).unwrap();
+//! let samples: Vec<_> = predict_images(&scene, &ImageSettings::for_scene(&scene))
+//!     .collect::<Result<_, _>>()
+//!     .unwrap();
 //! assert_eq!(samples.len(), 10);
 //! // Level at rest: +1 g on z at ±2 g full scale is 16384 = 0x4000, big-endian.
 //! assert_eq!(&samples[0].image[4..6], &[0x40, 0x00]);
 //! ```
 
+use super::predictor::{run_scene, Predictions};
 use crate::marg::MargSim;
 use crate::scene::chip::ChipSetup;
 use crate::scene::{FieldUnit, Scene};
@@ -67,34 +72,33 @@ pub struct PredictedSample {
     pub image: Image,
 }
 
-/// Every sample of `scene`, in order.
-pub fn predict(
-    scene: &Scene,
-    settings: &ImageSettings,
-) -> Result<Vec<PredictedSample>, crate::run::RunError> {
-    let mut marg = MargSim::new(scene).map_err(crate::run::RunError::Model)?;
-    let temperature = scene.spec.sensors.temperature;
-    let mut out = Vec::with_capacity(scene.samples() as usize);
-    crate::run::for_each(scene, |truth| {
-        let s = marg.sample(&in_chip_axes(truth, &scene.chip)).sample;
-        // Same expression as `MargSim`, so the temperature the model sees is the one sent.
-        let temp_c = temperature.map_or(settings.default_temp_c, |[start, slope]| {
-            (start + slope * truth.t_ns as f64 * 1e-9) as f32
-        });
-        let sample = PhysicalSample {
-            acc: s.acc,
-            gyr: s.gyr,
-            mag: s
-                .mag
-                .map(|v| (f64::from(v) * settings.mag_ut_per_unit) as f32),
-            temp_c,
-        };
-        out.push(PredictedSample {
-            truth: *truth,
-            image: settings.chip.image(&sample),
-        });
-    })?;
-    Ok(out)
+/// Every sample of `scene`, in order, predicted lazily on a thread of its own (see
+/// [`Predictions`]); an error (the scene's references, its sensor model) ends the iteration.
+pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<PredictedSample> {
+    let (scene, settings) = (scene.clone(), *settings);
+    Predictions::spawn(move |emit| {
+        let mut marg = MargSim::new(&scene).map_err(crate::run::RunError::Model)?;
+        let temperature = scene.spec.sensors.temperature;
+        run_scene(&scene, |truth| {
+            let s = marg.sample(&in_chip_axes(truth, &scene.chip)).sample;
+            // Same expression as `MargSim`, so the temperature the model sees is the one sent.
+            let temp_c = temperature.map_or(settings.default_temp_c, |[start, slope]| {
+                (start + slope * truth.t_ns as f64 * 1e-9) as f32
+            });
+            let sample = PhysicalSample {
+                acc: s.acc,
+                gyr: s.gyr,
+                mag: s
+                    .mag
+                    .map(|v| (f64::from(v) * settings.mag_ut_per_unit) as f32),
+                temp_c,
+            };
+            emit(PredictedSample {
+                truth: *truth,
+                image: settings.chip.image(&sample),
+            })
+        })
+    })
 }
 
 /// The truth's body-frame vectors (rate, specific force, field, angular acceleration) in the

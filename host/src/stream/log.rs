@@ -9,13 +9,13 @@
 //!
 //! | file | columns |
 //! |---|---|
-//! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample of the scene |
+//! | `truth.csv` | as `simulate` writes it (README, "Ground truth"), one row per sample, written as the session predicts them (in order, a window ahead of what it sends): every sample of the scene once the session completes |
 //! | `sent.csv` | one row per item written, in the order written. Source images: `index,t_ns,send_ns,late_ns,image,resend`: sample index, its latch instant, when the write of its batch to the port completed, how late that was against the batch's schedule `start_host_ns + t_ns − lead` of its first sample (empty for the prefill, written before Start, and for resends), the 22-byte register image as 44 lowercase hex digits, and `1` if the item was written again because the device had not received it (go-back-N; `0` for the first copy). Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend`: the kinematics sample's index and instant at the kinematics rate, the same times, the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip, and the resend flag |
-//! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample |
+//! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample and for entries the check cannot verify (see `served.rs`) |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before`: each write of the device under test (`bus` spi, i2c or aux; `dropped_before`: writes the device lost just before this batch) |
-//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
+//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `resend_out_of_window` (a hole older than the items the session keeps: not resent), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
 //!
 //! `meta.toml` ends with the `[completion]` table (status, samples written, why the session
 //! ended; [`crate::rundir`]), written once every file is closed: after the session, or after
@@ -83,6 +83,7 @@ pub struct SessionLog {
     telemetry: BufWriter<File>,
     register_writes: BufWriter<File>,
     events: BufWriter<File>,
+    truth: TruthWriter<BufWriter<File>>,
 }
 
 fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
@@ -92,7 +93,7 @@ fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
 }
 
 impl SessionLog {
-    /// Creates `dir` and every file but `truth.csv`, with their headers (`sent_columns`: the
+    /// Creates `dir` and every file, with their headers (`sent_columns`: the
     /// source mode's), and writes `meta.toml`.
     pub fn create(dir: &Path, meta: &str, sent_columns: &str) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
@@ -106,6 +107,10 @@ impl SessionLog {
             telemetry: create(dir, TELEMETRY_FILE, TELEMETRY_COLUMNS)?,
             register_writes: create(dir, REGISTER_WRITES_FILE, REGISTER_WRITES_COLUMNS)?,
             events: create(dir, EVENTS_FILE, EVENTS_COLUMNS)?,
+            truth: TruthWriter::new(BufWriter::with_capacity(
+                1 << 16,
+                File::create(dir.join(TRUTH_FILE))?,
+            ))?,
         };
         log.flush()?;
         Ok(log)
@@ -124,14 +129,9 @@ impl SessionLog {
         meta.write_all(text.as_bytes())
     }
 
-    /// Writes `truth.csv` in one go.
-    pub fn write_truth<'a>(&self, truths: impl Iterator<Item = &'a Truth>) -> io::Result<()> {
-        let file = BufWriter::with_capacity(1 << 20, File::create(self.dir.join(TRUTH_FILE))?);
-        let mut out = TruthWriter::new(file)?;
-        for t in truths {
-            out.write(t)?;
-        }
-        out.finish()?.flush()
+    /// Rows of `truth.csv`, in order.
+    pub fn truth(&mut self, truths: &[Truth]) -> io::Result<()> {
+        truths.iter().try_for_each(|t| self.truth.write(t))
     }
 
     /// One row of `sent.csv` in source mode images.
@@ -285,6 +285,7 @@ impl SessionLog {
         self.device.flush()?;
         self.telemetry.flush()?;
         self.register_writes.flush()?;
+        self.truth.flush()?;
         self.events.flush()
     }
 }

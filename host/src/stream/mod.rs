@@ -2,12 +2,17 @@
 //! mode of `docs/spec/link.md`: (a) register images, (b) true kinematics for the device's own
 //! sensor model.
 //!
-//! A [`Session`] first predicts every register image the device will serve for a validated
-//! [`Scene`](crate::scene::Scene): in mode (a) [`predict`] (truth →
+//! A [`Session`] predicts every register image the device will serve for a validated
+//! [`Scene`](crate::scene::Scene): in mode (a) [`predict_images`] (truth →
 //! [`MargSim`](crate::marg::MargSim) → the chip module's conversion with an explicit
 //! [`ImageSettings`]), in mode (b) [`predict_model`] (the firmware's zero-order hold of the
-//! kinematics and model steps, see [`model`]; scenes the device cannot run are refused here,
-//! before anything is sent). Then it speaks the link protocol over any byte port:
+//! kinematics and model steps, see [`model`]; scenes the device cannot run are refused when
+//! the session is created, before anything is sent). The prediction runs lazily, in order, just
+//! ahead of what is sent ([`Predictions`]), and the session keeps only a bounded window of it
+//! (what the device can still ask to be resent or report serving: its buffer capacity, see
+//! [`served::served_window`]); pacing statistics are histograms ([`Lateness`]). A session's
+//! memory therefore does not depend on the scene's length. Then it speaks the link protocol
+//! over any byte port:
 //!
 //! 1. Hello → HelloAck: the protocol version must match, and the device must emulate the
 //!    scene's chip model and support the source mode;
@@ -36,21 +41,28 @@
 mod ending;
 mod flow;
 pub mod images;
+mod lateness;
 pub mod log;
 mod logger;
 mod meta;
 pub mod model;
 mod pacing;
+pub mod predictor;
 mod reports;
 pub mod resend;
 pub mod rx;
 pub mod served;
 mod session;
 mod source;
+pub mod window;
 
-pub use images::{image_hex, parse_image_hex, predict, ImageSettings, PredictedSample};
-pub use model::{device_chip, kinematics_hold, model_images, predict_model, ModelPrediction};
-pub use served::{ServedCheck, ServedStats};
+pub use images::{image_hex, parse_image_hex, predict_images, ImageSettings, PredictedSample};
+pub use lateness::Lateness;
+pub use model::{
+    device_chip, kinematics_hold, model_images, predict_model, ModelPrediction, ModelSample,
+};
+pub use predictor::Predictions;
+pub use served::{served_window, ServedCheck, ServedStats};
 pub use session::{rate_of, Session, SourceMode, StreamConfig};
 
 use margemu_protocol::link::{HelloAck, RxStats, Telemetry};
@@ -134,6 +146,13 @@ pub enum StreamError {
         /// Rates that would do.
         hint: String,
     },
+    /// the prediction ended at sample {index} of {samples}
+    PredictionEnded {
+        /// The first sample missing.
+        index: u64,
+        /// Samples in the scene.
+        samples: u64,
+    },
     /// interrupted; the device was asked to stop and the logs are complete up to here
     Interrupted,
 }
@@ -177,7 +196,8 @@ pub struct JitterStats {
 }
 
 impl JitterStats {
-    /// Nearest-rank percentiles of `late` (ns).
+    /// Exact nearest-rank percentiles of `late` (ns); a session keeps a [`Lateness`] histogram
+    /// instead.
     pub fn from_lateness(late: &[i64]) -> Self {
         let mut v = late.to_vec();
         v.sort_unstable();

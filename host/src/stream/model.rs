@@ -1,8 +1,8 @@
 //! Source mode (b): the host sends true kinematics at a lower rate and the device runs the shared
 //! sensor model itself, seeded from the scene, at the chip's output rate.
 //!
-//! [`predict_model`] plans such a session and predicts, byte for byte, every register image the
-//! device will serve:
+//! [`predict_model`] plans such a session and predicts, byte for byte and lazily in order (a
+//! [`Predictions`] iterator), every register image the device will serve:
 //!
 //! - **kinematics**: output sample `k` of the scene has truth at `t_k`; the kinematics rate is
 //!   the output rate divided by a whole number `hold` (so kinematics instants fall on output
@@ -35,11 +35,14 @@
 //!     std::path::Path::new("inline.toml"),
 //! ).unwrap();
 //! let p = predict_model(&scene, &ImageSettings::for_scene(&scene), Some(250.0)).unwrap();
-//! assert_eq!((p.hold, p.kinematics.len(), p.samples.len()), (4, 3, 10));
+//! let samples: Vec<_> = p.samples.collect::<Result<_, _>>().unwrap();
+//! let kinematics = samples.iter().filter(|s| s.kinematics.is_some()).count();
+//! assert_eq!((p.hold, kinematics, samples.len()), (4, 3, 10));
 //! assert_eq!(p.params.truth_rate.as_hz_f64(), 250.0);
 //! ```
 
 use super::images::{in_chip_axes, ImageSettings, PredictedSample};
+use super::predictor::{run_scene, Predictions};
 use super::session::rate_of;
 use super::StreamError;
 use crate::scene::chip::ChipSetup;
@@ -55,16 +58,24 @@ use margemu_protocol::link::{Image, ModelParams, Rate};
 pub const DEFAULT_MAX_KINEMATICS_HZ: f64 = 1000.0;
 
 /// A planned source mode (b) session and its prediction.
-#[derive(Clone, Debug)]
 pub struct ModelPrediction {
     /// Output samples per kinematics sample.
     pub hold: u32,
     /// What Configure carries: seed, kinematics rate, µT per unit, the model terms.
     pub params: ModelParams,
-    /// The kinematics samples, at `params.truth_rate`.
-    pub kinematics: Vec<sensor::Truth>,
-    /// Every output sample: its truth and the image the device will serve.
-    pub samples: Vec<PredictedSample>,
+    /// Every output sample in order: its truth, the image the device will serve, and the
+    /// kinematics sample due at its instant (every `hold`-th sample's, from sample 0).
+    pub samples: Predictions<ModelSample>,
+}
+
+/// One output sample of source mode (b).
+#[derive(Clone, Copy, Debug)]
+pub struct ModelSample {
+    /// Its truth and the image the device serves.
+    pub sample: PredictedSample,
+    /// The kinematics sample the host sends for this instant, if one is due (index `k / hold`
+    /// at the kinematics rate).
+    pub kinematics: Option<sensor::Truth>,
 }
 
 /// Plans source mode (b) for `scene` with kinematics at `kinematics_hz` (default: see
@@ -93,27 +104,35 @@ pub fn predict_model(
     }
     let hold = kinematics_hold(rate, kinematics_hz)?;
     let truth_rate = Rate::new(rate.num(), rate.den() * hold).expect("checked by the hold");
-    let truths = crate::run::collect(scene).map_err(crate::run::RunError::from)?;
-    let temperature = scene.spec.sensors.temperature;
-    let kinematics: Vec<sensor::Truth> = truths
-        .iter()
-        .step_by(hold as usize)
-        .map(|t| kinematics_of(&in_chip_axes(t, &scene.chip), temperature))
-        .collect();
     let params = ModelParams {
         mag_ut_per_unit: settings.mag_ut_per_unit,
         ..ModelParams::new(scene.spec.seed, truth_rate, scene.spec.sensors.config())
     };
-    let images = model_images(&params, rate, hold, &kinematics, truths.len(), &chip)?;
-    let samples = truths
-        .into_iter()
-        .zip(images)
-        .map(|(truth, image)| PredictedSample { truth, image })
-        .collect();
+    let scene = scene.clone();
+    let samples = Predictions::spawn(move |emit| {
+        let mut marg = Marg::new(&params.marg, rate.as_hz_f64(), params.seed)
+            .map_err(crate::run::RunError::Model)?;
+        let temperature = scene.spec.sensors.temperature;
+        let (mut k, mut held) = (0u64, None);
+        run_scene(&scene, |truth| {
+            let kinematics = (k % u64::from(hold) == 0)
+                .then(|| kinematics_of(&in_chip_axes(truth, &scene.chip), temperature));
+            held = kinematics.or(held);
+            let t = held.as_ref().expect("sample 0 brings kinematics");
+            let image = setup::model_image(&mut marg, t, params.mag_ut_per_unit, &chip);
+            k += 1;
+            emit(ModelSample {
+                sample: PredictedSample {
+                    truth: *truth,
+                    image,
+                },
+                kinematics,
+            })
+        })
+    });
     Ok(ModelPrediction {
         hold,
         params,
-        kinematics,
         samples,
     })
 }

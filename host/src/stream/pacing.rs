@@ -9,14 +9,26 @@
 //! 200 µs before a due instant are busy-waited. Stop: see [`Run::finish`].
 
 use super::flow::Run;
+use super::resend::GoBackN;
+use super::served::{served_window, ServedCheck, MAX_WINDOW};
+use super::window::Window;
 use super::Progress;
 use super::StreamError;
 use margemu_protocol::link::{DeviceState, Message, Start};
 use std::io::Write;
 use std::time::{Duration, Instant};
 
+/// Batches predicted beyond the next one to write.
+const PREDICT_AHEAD: u64 = 2;
+
 impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
-    /// Sets the batch size and the lead from the device's HelloAck (see the module docs).
+    /// Sets the batch size and the lead from the device's HelloAck (see the module docs), and
+    /// the windows of what the session keeps: the write times of the last `buffer_capacity`
+    /// items and a batch (a go-back starts no earlier than the credit window, `limit −
+    /// buffer_capacity`, and nothing was written at or beyond `limit`); the items themselves,
+    /// predicted up to [`PREDICT_AHEAD`] batches beyond the next to write (so a go-back always
+    /// finds them); the Served check's ([`served_window`], those predicted ahead counted as
+    /// buffered).
     pub(super) fn plan_pacing(&mut self) {
         let (max_batch, capacity) = self.ack.map_or((1, 4), |a| {
             let c = a.capabilities;
@@ -36,6 +48,13 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             .sample_time_ns(3 * capacity as u64 / 8);
         self.batch = batch as u64;
         self.lead = self.session.config.lead.min(Duration::from_nanos(window));
+        let ahead = PREDICT_AHEAD as usize * batch;
+        let buffered = u32::try_from(capacity.saturating_add(ahead)).unwrap_or(u32::MAX);
+        let hold = u32::try_from(self.session.hold()).unwrap_or(u32::MAX);
+        self.served = ServedCheck::new(self.total(), served_window(buffered, hold));
+        let items = capacity.saturating_add(batch).min(MAX_WINDOW);
+        self.go_back = GoBackN::new(items);
+        self.session.prediction.items = Window::new(items + ahead + batch);
     }
 
     /// The instant the batch starting at item `j` is due (`None` before Start).
@@ -62,6 +81,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     ) -> Result<(), StreamError> {
         let first = self.next;
         let resend = first < self.go_back.high();
+        self.session.predict_through(first + n, &mut self.served)?;
         let started = Instant::now();
         let len = self
             .session
@@ -76,8 +96,8 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         self.go_back.written(first, n, send_ns);
         if let (Some(due), true) = (due, paced && !resend) {
             let late = |at: Instant| at.saturating_duration_since(due).as_nanos() as i64;
-            self.late.push(late(started));
-            self.written_late.push(late(sent_at));
+            self.late.record(late(started));
+            self.written_late.record(late(sent_at));
             self.max_late_ns = self.max_late_ns.max(late(started));
         }
         self.next += n;
@@ -123,6 +143,9 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     fn send_next(&mut self, stall: &mut Option<Instant>) -> Result<(), StreamError> {
         let total = self.session.stream_len();
         self.report(false);
+        // Predicted ahead while there is time, so a due batch never waits for its prediction.
+        let ahead = (self.next + PREDICT_AHEAD * self.batch).min(total);
+        self.session.predict_through(ahead, &mut self.served)?;
         let due = self.due(self.next).expect("started");
         let spin = self.session.config.spin;
         if Instant::now() + spin < due {

@@ -136,6 +136,14 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
                 self.go_back.rewound();
                 self.event("resend", &detail)
             }
+            None if next_index < self.next && self.go_back.forgotten(next_index) => {
+                let detail = format!(
+                    "device next_index {next_index} at its scene time {tau} ns is older than the \
+                     items kept (from {}): not resent",
+                    self.go_back.forgotten_below()
+                );
+                self.event("resend_out_of_window", &detail)
+            }
             _ => Ok(()),
         }
     }

@@ -15,6 +15,11 @@
 //! clock starts when it receives Start, after the host's), so the hole must have been written
 //! before `start + τ − margin` (`StreamConfig::resend_after`: the line's delivery time).
 //!
+//! The write times are kept for the newest items only (a [`Window`] of the device's buffer
+//! capacity and a batch: the hole is never older than the credit window's start, `limit −
+//! buffer_capacity`, and nothing at or beyond `limit` was written); an older hole cannot be
+//! resent ([`GoBackN::forgotten`]).
+//!
 //! ```
 //! use margemu::stream::resend::GoBackN;
 //! let mut g = GoBackN::new(100);
@@ -28,20 +33,22 @@
 //! assert_eq!(g.lost(64, 10_000), None);
 //! ```
 
-/// When each item was last written, and how many were written again.
+use super::window::Window;
+
+/// When each recent item was last written, and how many were written again.
 #[derive(Clone, Debug)]
 pub struct GoBackN {
-    last_written_ns: Vec<i64>,
+    last_written_ns: Window<i64>,
     high: u64,
     rewinds: u64,
     resent: u64,
 }
 
 impl GoBackN {
-    /// A stream of `len` items, none written.
-    pub fn new(len: u64) -> Self {
+    /// None written yet; the write times of the newest `span` items are kept.
+    pub fn new(span: usize) -> Self {
         Self {
-            last_written_ns: vec![i64::MIN; len as usize],
+            last_written_ns: Window::new(span),
             high: 0,
             rewinds: 0,
             resent: 0,
@@ -53,8 +60,16 @@ impl GoBackN {
         let again = self.high.saturating_sub(first).min(n);
         self.resent += again;
         let end = first + n;
-        for t in &mut self.last_written_ns[first as usize..end as usize] {
-            *t = at_ns;
+        for index in first..end {
+            let times = &mut self.last_written_ns;
+            if index >= times.end() {
+                if index > times.end() {
+                    times.forget_below(index); // items were skipped
+                }
+                times.push(at_ns);
+            } else if let Some(t) = times.get_mut(index) {
+                *t = at_ns;
+            } // else forgotten: older than the window
         }
         self.high = self.high.max(end);
     }
@@ -68,10 +83,19 @@ impl GoBackN {
     /// time `seen_by_ns` (less the delivery margin), is due to be written again:
     /// `Some(next_index)` if it was written, last before `seen_by_ns`.
     pub fn lost(&self, next_index: u64, seen_by_ns: i64) -> Option<u64> {
-        let written = *self
-            .last_written_ns
-            .get(usize::try_from(next_index).ok()?)?;
+        let written = *self.last_written_ns.get(next_index)?;
         (next_index < self.high && written <= seen_by_ns).then_some(next_index)
+    }
+
+    /// Whether item `index` was written but is older than the write times kept, so it cannot
+    /// be resent.
+    pub fn forgotten(&self, index: u64) -> bool {
+        index < self.forgotten_below()
+    }
+
+    /// The oldest item whose write time is kept.
+    pub fn forgotten_below(&self) -> u64 {
+        self.last_written_ns.start()
     }
 
     /// Counts a go-back.
@@ -106,5 +130,15 @@ mod tests {
         assert_eq!(g.lost(3, 300), Some(3));
         assert_eq!(g.lost(9, 1000), None, "never written");
         assert_eq!(g.lost(u64::MAX, 1000), None);
+    }
+
+    #[test]
+    fn only_the_newest_write_times_are_kept() {
+        let mut g = GoBackN::new(4);
+        g.written(0, 6, 100);
+        assert!(g.forgotten(1) && !g.forgotten(2));
+        assert_eq!((g.lost(1, 200), g.lost(2, 200)), (None, Some(2)));
+        g.written(0, 3, 300); // a go-back older than the window: counted, 2 restamped
+        assert_eq!((g.resent(), g.lost(2, 200)), (3, None));
     }
 }

@@ -2,13 +2,13 @@
 //! batches, stop), over any byte port.
 
 use super::flow::Run;
-use super::images::{predict, ImageSettings, PredictedSample};
+use super::images::{predict_images, ImageSettings};
 use super::log::{SessionLog, SENT_COLUMNS, SENT_KINEMATICS_COLUMNS};
 use super::logger::Logger;
 use super::meta::metadata;
 use super::model::predict_model;
 use super::rx;
-use super::source::Items;
+use super::source::{Items, Prediction};
 use super::{Progress, StreamError, Summary};
 use crate::rundir::{Completion, CompletionRecord, Status};
 use crate::scene::chip::ChipSetup;
@@ -90,15 +90,18 @@ impl Default for StreamConfig {
     }
 }
 
-/// One streaming run of one scene: its predicted samples, its settings and its log directory.
+/// One streaming run of one scene: its prediction (read lazily, a bounded window at a time),
+/// its settings and its log directory.
 pub struct Session {
     pub(super) config: StreamConfig,
     pub(super) settings: ImageSettings,
     /// The chip Configure asks for (the scene's `[chip]`).
     pub(super) chip: ChipSetup,
     pub(super) rate: Rate,
-    pub(super) samples: Vec<PredictedSample>,
+    /// Output samples in the scene.
+    pub(super) samples: u64,
     pub(super) items: Items,
+    pub(super) prediction: Prediction,
     pub(super) log: Logger,
     pub(super) stop: Arc<AtomicBool>,
     /// Host time 0 of the logs; `None`: when the run begins.
@@ -106,25 +109,31 @@ pub struct Session {
 }
 
 impl Session {
-    /// Predicts every image of `scene` (in source mode model, after checking the device can run
-    /// it) and creates the session directory `dir` (`meta.toml`, `truth.csv`, the other files
-    /// with their headers). Nothing is sent yet.
+    /// Starts predicting the images of `scene` (in source mode model, after checking the device
+    /// can run it; the prediction runs lazily, a bounded window ahead of what is sent, so this
+    /// takes the same time and memory for any length of scene) and creates the session
+    /// directory `dir` (`meta.toml`, every file with its header). Nothing is sent yet.
     pub fn new(scene: &Scene, config: StreamConfig, dir: &Path) -> Result<Self, StreamError> {
         let settings = config
             .images
             .unwrap_or_else(|| ImageSettings::for_scene(scene));
         let rate = rate_of(scene)?;
-        let (samples, items, hold) = match config.source {
-            SourceMode::Images => (predict(scene, &settings)?, Items::Images, None),
+        let (mut prediction, items, hold) = match config.source {
+            SourceMode::Images => (
+                Prediction::images(predict_images(scene, &settings)),
+                Items::Images,
+                None,
+            ),
             SourceMode::Model { kinematics_hz } => {
                 let p = predict_model(scene, &settings, kinematics_hz)?;
                 let items = Items::Kinematics {
                     params: Box::new(p.params),
-                    samples: p.kinematics,
+                    hold: p.hold,
                 };
-                (p.samples, items, Some(p.hold))
+                (Prediction::model(p.samples), items, Some(p.hold))
             }
         };
+        prediction.check_start()?;
         let meta = metadata(scene, &config, &settings, rate, hold);
         let log_err = |source| StreamError::Log {
             path: dir.to_path_buf(),
@@ -135,16 +144,15 @@ impl Session {
             Items::Kinematics { .. } => SENT_KINEMATICS_COLUMNS,
         };
         let log = SessionLog::create(dir, &meta, sent_columns).map_err(log_err)?;
-        log.write_truth(samples.iter().map(|s| &s.truth))
-            .map_err(log_err)?;
         let log = Logger::spawn(log).map_err(log_err)?;
         Ok(Self {
             config,
             settings,
             chip: scene.chip,
             rate,
-            samples,
+            samples: scene.samples(),
             items,
+            prediction,
             log,
             stop: Arc::new(AtomicBool::new(false)),
             origin: None,
@@ -171,9 +179,10 @@ impl Session {
         self.log.completion()
     }
 
-    /// The predicted output samples, in order (truth and the image the device should serve).
-    pub fn samples(&self) -> &[PredictedSample] {
-        &self.samples
+    /// Output samples in the scene (their images: [`predict_images`](super::predict_images)
+    /// with [`Session::image_settings`]).
+    pub fn sample_count(&self) -> u64 {
+        self.samples
     }
 
     /// The register settings the images were computed with.
