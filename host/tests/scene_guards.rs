@@ -306,6 +306,30 @@ fn a_non_finite_truth_stops_the_run_at_its_csv_rows() {
     assert_no_non_finite(&run);
 }
 
+/// The same scene through `loopback`: the session's prediction stops at the same place, before
+/// anything is streamed, and the session says it failed.
+#[test]
+fn a_non_finite_truth_stops_a_loopback_session() {
+    let dir = folder("csv-inf-loopback");
+    write(&dir, "close.csv", "t,v\n0,0\n1e-310,1\n1,1\n");
+    let scene = write(
+        &dir,
+        "scene.toml",
+        &format!(
+            "{BASE}motion = \"kinematic\"\n[joints.x]\ntype = \"csv\"\nfile = \"close.csv\"\ncolumn = \"v\"\n"
+        ),
+    );
+    let session = dir.join("session");
+    let err = fails(&["loopback", s(&scene), "-o", s(&session)]);
+    assert!(
+        err.contains("sample 0 (t = 0 ns): joint x position is NaN, not finite"),
+        "{err}"
+    );
+    let sent = std::fs::read_to_string(session.join("sent.csv")).unwrap_or_default();
+    assert!(sent.lines().count() <= 1, "samples were sent: {sent}");
+    assert_no_non_finite(&session);
+}
+
 /// Explicit gains far too stiff for the integrator step blow the bench up: the run stops at the
 /// first non-finite value and names the bench dynamics of the joint.
 #[test]
