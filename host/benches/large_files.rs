@@ -52,11 +52,15 @@ fn generate(dir: &Path, rows: u64) -> std::io::Result<()> {
     }
     let started = Instant::now();
     std::fs::create_dir_all(dir.join("run"))?;
-    let open = |name: &str| File::create(dir.join(name)).map(|f| BufWriter::with_capacity(1 << 20, f));
+    let open =
+        |name: &str| File::create(dir.join(name)).map(|f| BufWriter::with_capacity(1 << 20, f));
     let mut truth = open("run/truth.csv")?;
     let mut est = open("estimates.csv")?;
     let mut rec = open("recording.csv")?;
-    writeln!(truth, "t_ns,qw,qx,qy,qz,wx,wy,wz,fx,fy,fz,ax_b,ay_b,az_b,mx,my,mz")?;
+    writeln!(
+        truth,
+        "t_ns,qw,qx,qy,qz,wx,wy,wz,fx,fy,fz,ax_b,ay_b,az_b,mx,my,mz"
+    )?;
     writeln!(est, "t_s,qw,qx,qy,qz")?;
     writeln!(rec, "t_s,ax,ay,az,gx,gy,gz,mx,my,mz")?;
     for k in 0..rows {
@@ -105,7 +109,11 @@ fn measure(bin: &Path, args: &[&str]) -> (f64, f64) {
         .output()
         .expect("GNU time runs (apt-get install time)");
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{} {args:?} failed: {stderr}", bin.display());
+    assert!(
+        output.status.success(),
+        "{} {args:?} failed: {stderr}",
+        bin.display()
+    );
     let last = stderr.lines().last().unwrap_or_default();
     let mut fields = last.split(' ').map(|f| f.parse::<f64>());
     match (fields.next(), fields.next()) {
@@ -133,7 +141,10 @@ fn main() {
     let (run, est, rec) = (p("run"), p("estimates.csv"), p("recording.csv"));
     let (out, filtered) = (p("evaluation"), p("filtered.csv"));
     println!("binary: {}", bin.display());
-    println!("{:<54} {:>10} {:>14}", "command", "wall (s)", "peak RSS (MiB)");
+    println!(
+        "{:<54} {:>10} {:>14}",
+        "command", "wall (s)", "peak RSS (MiB)"
+    );
     let cases: [(&str, Vec<&str>); 2] = [
         (
             "evaluate RUN --estimates estimates.csv --out DIR",

@@ -28,12 +28,17 @@ pub mod quat;
 pub mod report;
 pub mod run;
 pub mod score;
+mod series;
 pub mod signals;
 pub mod stats;
+pub mod thin;
+mod walk;
 
 pub use align::{estimate_latency, fit_clock, ClockFit, Latency, LatencySearch};
 pub use phase::{Phase, PhaseRules};
-pub use run::{evaluate, EvalError, EvalOptions, Evaluation, LatencyMode, Source};
+pub use run::{
+    evaluate, evaluate_writing, EvalError, EvalOptions, Evaluation, LatencyMode, Source,
+};
 pub use score::{score, Compared, Estimates, Reference, ScoreError, ScoreOptions, Scores, Stamped};
 
 /// Runs `step` over IMU samples in order and stamps each quaternion it returns with the

@@ -79,22 +79,51 @@ pub struct PhaseSample {
     pub field: f64,
 }
 
+/// What the rules see of one instant, before the window: whether its field is perturbed and
+/// whether it is quiet (slow and unaccelerated). One byte per instant, for long runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Marks {
+    /// The field deviation is above the threshold.
+    pub perturbed: bool,
+    /// Body rate and external acceleration are below theirs.
+    pub quiet: bool,
+}
+
+impl Marks {
+    /// The marks of `sample` under `rules`.
+    pub fn of(sample: &PhaseSample, rules: &PhaseRules) -> Self {
+        Self {
+            perturbed: sample.field > rules.magnetic_fraction,
+            quiet: sample.rate < rules.static_rate && sample.accel < rules.static_accel,
+        }
+    }
+}
+
 /// The phase of every sample, `step_ns` apart.
 pub fn classify(samples: &[PhaseSample], rules: &PhaseRules, step_ns: u64) -> Vec<Phase> {
+    let marks: Vec<Marks> = samples.iter().map(|s| Marks::of(s, rules)).collect();
+    classify_marks(&marks, rules, step_ns)
+}
+
+/// The phase of every instant from its marks, `step_ns` apart: magnetic when some instant
+/// within half a window is perturbed (a count of perturbed instants slid along), else static
+/// when quiet, else dynamic.
+pub fn classify_marks(marks: &[Marks], rules: &PhaseRules, step_ns: u64) -> Vec<Phase> {
     let half = (rules.window_ns / 2 / step_ns.max(1)) as usize;
-    let perturbed: Vec<[f64; 1]> = samples
-        .iter()
-        .map(|s| [f64::from(u8::from(s.field > rules.magnetic_fraction))])
-        .collect();
-    // A mean above zero over the window: some instant in it is perturbed.
-    let near = moving_mean(&perturbed, half);
-    samples
-        .iter()
-        .zip(near)
-        .map(|(s, near)| {
-            if near[0] > 0.0 {
+    let n = marks.len();
+    let perturbed = |i: usize| usize::from(marks[i].perturbed);
+    let mut near = (0..half.min(n)).map(perturbed).sum::<usize>();
+    (0..n)
+        .map(|i| {
+            if let Some(k) = i.checked_add(half).filter(|&k| k < n) {
+                near += perturbed(k);
+            }
+            if i > half {
+                near -= perturbed(i - half - 1);
+            }
+            if near > 0 {
                 Phase::Magnetic
-            } else if s.rate < rules.static_rate && s.accel < rules.static_accel {
+            } else if marks[i].quiet {
                 Phase::Static
             } else {
                 Phase::Dynamic
