@@ -292,6 +292,64 @@ pub fn read_external(path: &Path) -> Result<External, ColumnError> {
     Ok(out)
 }
 
+/// `t_ns` and three-column groups of a simulation's CSV (`perturbation.csv`, `marg.csv`), read
+/// a row at a time, `t_ns` strictly increasing.
+pub(crate) struct VectorRows<const G: usize> {
+    table: Table,
+    t: usize,
+    cols: [[usize; 3]; G],
+    last: Option<u64>,
+    ahead: Option<(u64, [[f64; 3]; G])>,
+}
+
+impl<const G: usize> VectorRows<G> {
+    /// Opens `path` and finds its columns.
+    pub(crate) fn open(path: &Path, groups: [[&str; 3]; G]) -> Result<Self, ColumnError> {
+        let table = Table::open(path)?;
+        let t = table.column("t_ns")?;
+        let mut cols = [[0usize; 3]; G];
+        for (c, names) in cols.iter_mut().zip(groups) {
+            *c = table.columns(names)?;
+        }
+        Ok(Self {
+            table,
+            t,
+            cols,
+            last: None,
+            ahead: None,
+        })
+    }
+
+    /// The next row: its instant and a vector per group.
+    pub(crate) fn next(&mut self) -> Result<Option<(u64, [[f64; 3]; G])>, ColumnError> {
+        if let Some(row) = self.ahead.take() {
+            return Ok(Some(row));
+        }
+        let Some(row) = self.table.next_row()? else {
+            return Ok(None);
+        };
+        let t: u64 = row.int(self.t)?;
+        row.check_order(self.t, self.last, t, true)?;
+        let mut values = [[0.0; 3]; G];
+        for (v, c) in values.iter_mut().zip(self.cols) {
+            *v = row.f64s(c)?;
+        }
+        self.last = Some(t);
+        Ok(Some((t, values)))
+    }
+
+    /// The row at instant `t` if there is one; `t` must increase from call to call.
+    pub(crate) fn at(&mut self, t: u64) -> Result<Option<[[f64; 3]; G]>, ColumnError> {
+        while let Some((s, values)) = self.next()? {
+            if s >= t {
+                self.ahead = Some((s, values));
+                return Ok((s == t).then_some(values));
+            }
+        }
+        Ok(None)
+    }
+}
+
 /// Instants (ns) and, per group of three columns, one vector per row.
 pub type Vectors<const G: usize> = (Vec<u64>, [Vec<[f64; 3]>; G]);
 
@@ -300,22 +358,26 @@ pub fn read_vectors<const G: usize>(
     path: &Path,
     groups: [[&str; 3]; G],
 ) -> Result<Vectors<G>, ColumnError> {
-    let table = Table::open(path)?;
-    let t = table.column("t_ns")?;
-    let mut cols = [[0usize; 3]; G];
-    for (c, names) in cols.iter_mut().zip(groups) {
-        *c = table.columns(names)?;
-    }
+    let mut rows = VectorRows::open(path, groups)?;
     let mut times: Vec<u64> = Vec::new();
     let mut values: [Vec<[f64; 3]>; G] = core::array::from_fn(|_| Vec::new());
-    table.for_each(|row| {
-        let t_ns: u64 = row.int(t)?;
-        row.check_order(t, times.last().copied(), t_ns, true)?;
-        times.push(t_ns);
-        for (v, c) in values.iter_mut().zip(cols) {
-            v.push(row.f64s(c)?);
+    while let Some((t, row)) = rows.next()? {
+        times.push(t);
+        for (v, r) in values.iter_mut().zip(row) {
+            v.push(r);
         }
-        Ok(())
-    })?;
+    }
     Ok((times, values))
+}
+
+/// The first sample of `truth.csv` (its instant and attitude, normalised), `None` when it has
+/// no data row; the rest of the file is not read.
+pub fn read_first_attitude(path: &Path) -> Result<Option<Stamped>, ColumnError> {
+    let mut table = Table::open(path)?;
+    let t = table.column("t_ns")?;
+    let q = table.columns(["qw", "qx", "qy", "qz"])?;
+    let Some(row) = table.next_row()? else {
+        return Ok(None);
+    };
+    Ok(Some((row.int(t)?, unit(&row, row.f64s(q)?)?)))
 }

@@ -18,7 +18,7 @@
 
 use super::align::{fit_clock, TruthFacts};
 use super::device_log::{read_meta, read_sent};
-use super::input::{read_dut_attitude, read_external, DutRow, Imu};
+use super::input::{read_dut_attitude, read_external, DutRow, Imu, VectorRows};
 use super::phase::{classify, classify_marks, Marks, Phase, PhaseRules, PhaseSample};
 use super::quat::{from_euler, geodesic, normalize};
 use super::run::{Clock, EvalError, EvalOptions, LatencyMode, Norms, Source};
@@ -85,7 +85,7 @@ fn scan_truth(
     let m_cols = table.columns(["mx", "my", "mz"])?;
     let perturbation_path = dir.join("perturbation.csv");
     let mut perturbation = if perturbation_path.exists() {
-        Some(Vectors::open(
+        Some(VectorRows::open(
             &perturbation_path,
             [["mag_x", "mag_y", "mag_z"]],
         )?)
@@ -162,7 +162,7 @@ fn scan_truth(
         );
     } else if marg.exists() {
         figure_norms = Norms::new("marg.csv (sensor model output)");
-        let mut v = Vectors::open(
+        let mut v = VectorRows::open(
             &marg,
             [["acc_x", "acc_y", "acc_z"], ["mag_x", "mag_y", "mag_z"]],
         )?;
@@ -179,62 +179,6 @@ fn scan_truth(
         phases: classify_marks(&marks, rules, step),
         norms: figure_norms,
     })
-}
-
-/// `t_ns` and three-column groups of a simulation's CSV (`perturbation.csv`, `marg.csv`), read
-/// a row at a time, `t_ns` strictly increasing.
-struct Vectors<const G: usize> {
-    table: Table,
-    t: usize,
-    cols: [[usize; 3]; G],
-    last: Option<u64>,
-    ahead: Option<(u64, [[f64; 3]; G])>,
-}
-
-impl<const G: usize> Vectors<G> {
-    fn open(path: &Path, groups: [[&str; 3]; G]) -> Result<Self, EvalError> {
-        let table = Table::open(path)?;
-        let t = table.column("t_ns")?;
-        let mut cols = [[0usize; 3]; G];
-        for (c, names) in cols.iter_mut().zip(groups) {
-            *c = table.columns(names)?;
-        }
-        Ok(Self {
-            table,
-            t,
-            cols,
-            last: None,
-            ahead: None,
-        })
-    }
-
-    fn next(&mut self) -> Result<Option<(u64, [[f64; 3]; G])>, EvalError> {
-        if let Some(row) = self.ahead.take() {
-            return Ok(Some(row));
-        }
-        let Some(row) = self.table.next_row()? else {
-            return Ok(None);
-        };
-        let t: u64 = row.int(self.t)?;
-        row.check_order(self.t, self.last, t, true)?;
-        let mut values = [[0.0; 3]; G];
-        for (v, c) in values.iter_mut().zip(self.cols) {
-            *v = row.f64s(c)?;
-        }
-        self.last = Some(t);
-        Ok(Some((t, values)))
-    }
-
-    /// The row at instant `t` if there is one; `t` must increase from call to call.
-    fn at(&mut self, t: u64) -> Result<Option<[[f64; 3]; G]>, EvalError> {
-        while let Some((s, values)) = self.next()? {
-            if s >= t {
-                self.ahead = Some((s, values));
-                return Ok((s == t).then_some(values));
-            }
-        }
-        Ok(None)
-    }
 }
 
 /// `values` (at `times`) at each instant of `grid`; zero where `times` has no such instant.

@@ -41,18 +41,30 @@ pub use run::{
 };
 pub use score::{score, Compared, Estimates, Reference, ScoreError, ScoreOptions, Scores, Stamped};
 
+/// Steps whose median is the time step of the first sample (which has no predecessor): those
+/// of the first samples only, so a reader that streams a long recording need not hold it.
+pub const FIRST_STEP_WINDOW: usize = 65_536;
+
+/// The time step (s) given to the first sample of `t_ns` (the first instants of a recording, at
+/// least [`FIRST_STEP_WINDOW`]` + 1` of them when it has that many): the median step between
+/// them, 0 for a single sample.
+pub fn first_step_s(t_ns: &[u64]) -> f64 {
+    let head = &t_ns[..t_ns.len().min(FIRST_STEP_WINDOW + 1)];
+    let mut steps: Vec<u64> = head.windows(2).map(|w| w[1] - w[0]).collect();
+    steps.sort_unstable();
+    steps.get(steps.len() / 2).copied().unwrap_or(0) as f64 * 1e-9
+}
+
 /// Runs `step` over IMU samples in order and stamps each quaternion it returns with the
 /// sample's instant: `step(k, dt)` gets the sample index and the time since the previous sample
-/// (s; the median step for the first). The seam through which an attitude filter (`update` then
+/// (s; [`first_step_s`] for the first). The seam through which an attitude filter (`update` then
 /// `quaternion`) produces estimates for [`score()`].
 pub fn estimate_with(
     imu: &input::Imu,
     mut step: impl FnMut(usize, f64) -> quat::Quat,
 ) -> Vec<Stamped> {
     let t = &imu.t_ns;
-    let mut steps: Vec<u64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    steps.sort_unstable();
-    let first = steps.get(steps.len() / 2).copied().unwrap_or(0) as f64 * 1e-9;
+    let first = first_step_s(t);
     (0..t.len())
         .map(|k| {
             let dt = if k == 0 {
