@@ -46,12 +46,28 @@ pub(super) struct Loaded {
 
 /// Reads `source`.
 pub(super) fn load(source: &Source, options: &EvalOptions) -> Result<Loaded, EvalError> {
+    if let Source::Session(dir) | Source::Estimates { dir, .. } = source {
+        run_directory(dir)?;
+    }
     match source {
         Source::Session(dir) => load_session(dir, options),
         Source::Estimates { dir, estimates } => load_run(dir, estimates, &options.rules),
         Source::External { file, estimates } => {
             load_external(file, estimates.as_deref(), &options.rules)
         }
+    }
+}
+
+/// Checks a run or session directory as a whole before any of its files is read: the one place
+/// for such checks.
+fn run_directory(dir: &Path) -> Result<(), EvalError> {
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(EvalError::Input {
+            path: dir.to_path_buf(),
+            reason: "no such directory".into(),
+        })
     }
 }
 

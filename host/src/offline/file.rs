@@ -14,6 +14,9 @@ use margemu_filters::Initial;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+/// Samples parsed per batch handed from the reading thread to the filtering one.
+const BATCH: usize = 4096;
+
 /// A filter run that could not be done.
 #[derive(Debug, thiserror::Error, docsplay::Display)]
 pub enum FilterError {
@@ -109,16 +112,38 @@ pub fn filter_to_file(
         filter.update(&margemu_filters::Imu { gyro, acc, mag }, dt);
         write_estimate(out, &mut float, t_ns, filter.quaternion())
     };
-    let result = (|| {
+    let result = std::thread::scope(|scope| {
+        // Parsing on a second thread, in batches (a few in flight), while this one filters and
+        // writes: the two take about as long each.
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Result<Vec<Sample>, InputError>>(4);
+        scope.spawn(move || loop {
+            let mut batch = Vec::with_capacity(BATCH);
+            while batch.len() < BATCH {
+                match samples.next_sample() {
+                    Ok(Some(s)) => batch.push(s),
+                    Ok(None) => break,
+                    Err(e) => {
+                        let _ = tx.send(Err(e));
+                        return;
+                    }
+                }
+            }
+            let last = batch.len() < BATCH;
+            if tx.send(Ok(batch)).is_err() || last {
+                return;
+            }
+        });
         writeln!(out, "{}", ESTIMATE_COLUMNS.join(",")).map_err(write_err)?;
         for s in head {
             step(s, &mut out).map_err(write_err)?;
         }
-        while let Some(s) = samples.next_sample()? {
-            step(s, &mut out).map_err(write_err)?;
+        for batch in rx {
+            for s in batch? {
+                step(s, &mut out).map_err(write_err)?;
+            }
         }
         out.flush().map_err(write_err)
-    })();
+    });
     match result {
         Ok(()) => Ok(run),
         Err(e) => {
