@@ -8,7 +8,10 @@
 //! `[−max_lag, +max_lag]` in steps of the truth's sample period, on at most about 2000
 //! estimates (and only at lags where at least half as many overlap as at the best overlapping
 //! lag); a golden-section search over the two steps around the coarse minimum, on every
-//! estimate, refines it to 100 ns. `L` is the whole delay from the instant a sample
+//! estimate up to [`FINE_POINTS`] (evenly spaced ones beyond: the cost is a smooth mean, and
+//! those estimates with the truth around them fit in memory), refines it to 100 ns. Files are
+//! read once for the scan and once to gather the refinement's estimates, with only a window of
+//! the truth in memory. `L` is the whole delay from the instant a sample
 //! describes to the time stamp its estimate carries: transport, the filter's processing and its
 //! own phase lag alike. Motion is what makes `L` observable: when the lowest cost is not at least
 //! 20 % below the median cost of the scan (a plate at rest, say), the estimate is reported as

@@ -11,8 +11,11 @@
 //! - [`phase`]: the phase rules; [`signals`]: their magnitudes from measured signals;
 //! - [`input`] and [`device_log`]: the files (`truth.csv`, `dut_attitude.csv`, estimates,
 //!   external recordings, `meta.toml`, `sent.csv`), every bad value located;
-//! - [`run`]: one evaluation from files ([`evaluate()`]), read by `load`; [`report`] and [`plot`]: its
-//!   table, `report.md`, `errors.csv` and the figures (PNG and SVG).
+//! - [`run`]: one evaluation from files ([`evaluate()`], [`evaluate_writing`]), read by `load`
+//!   into re-readable series (`series`: a file on disk, read again for each pass) and walked with
+//!   a window of the truth (`walk`), so memory does not grow with the run; [`report`] and
+//!   [`plot`]: its table, `report.md`, `errors.csv` (written row by row) and the figures (PNG
+//!   and SVG) from series thinned as they come ([`thin`]).
 //!
 //! Filters plug in as data: anything that turns IMU samples into quaternions produces an
 //! estimate list ([`estimate_with`] runs such a step function over an external recording's
