@@ -186,6 +186,39 @@ mod tests {
     }
 
     #[test]
+    fn the_sliding_count_marks_what_a_window_mean_marks() {
+        // Perturbed instants in a pattern with runs and gaps of several lengths.
+        let marks: Vec<Marks> = (0..200u32)
+            .map(|i| Marks {
+                perturbed: (i * 7919) % 23 < 2 || (90..95).contains(&i),
+                quiet: i % 3 == 0,
+            })
+            .collect();
+        let flags: Vec<[f64; 1]> = marks
+            .iter()
+            .map(|m| [f64::from(u8::from(m.perturbed))])
+            .collect();
+        let rules = PhaseRules::default();
+        for step_ns in [1_000_000_000, 50_000_000, 10_000_000, 3_000_000, 1_000_000] {
+            let half = (rules.window_ns / 2 / step_ns) as usize;
+            let expected: Vec<Phase> = moving_mean(&flags, half)
+                .iter()
+                .zip(&marks)
+                .map(|(near, m)| match (near[0] > 0.0, m.quiet) {
+                    (true, _) => Phase::Magnetic,
+                    (false, true) => Phase::Static,
+                    (false, false) => Phase::Dynamic,
+                })
+                .collect();
+            assert_eq!(
+                classify_marks(&marks, &rules, step_ns),
+                expected,
+                "{step_ns}"
+            );
+        }
+    }
+
+    #[test]
     fn moving_mean_averages_a_centred_window() {
         let v: Vec<[f64; 1]> = [1.0, 2.0, 3.0, 4.0, 5.0].iter().map(|&x| [x]).collect();
         let m = moving_mean(&v, 1);
