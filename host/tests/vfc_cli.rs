@@ -328,7 +328,7 @@ fn evaluate_scores_one_message_stream_of_a_loopback_session_by_default() {
     assert!(!all.contains("not used"), "{all}");
     assert!(all.contains("rows stamped through the fit"), "{all}");
     assert!(
-        all.contains("scored mavlink/ATTITUDE_QUATERNION (choose another with --message)"),
+        all.contains("scored mavlink2/ATTITUDE_QUATERNION (choose another with --message)"),
         "{all}"
     );
     assert!(
