@@ -292,6 +292,9 @@ pub fn read_external(path: &Path) -> Result<External, ColumnError> {
     Ok(out)
 }
 
+/// A row of [`VectorRows`]: its instant (ns) and a vector per group.
+pub(crate) type VectorRow<const G: usize> = (u64, [[f64; 3]; G]);
+
 /// `t_ns` and three-column groups of a simulation's CSV (`perturbation.csv`, `marg.csv`), read
 /// a row at a time, `t_ns` strictly increasing.
 pub(crate) struct VectorRows<const G: usize> {
@@ -299,7 +302,7 @@ pub(crate) struct VectorRows<const G: usize> {
     t: usize,
     cols: [[usize; 3]; G],
     last: Option<u64>,
-    ahead: Option<(u64, [[f64; 3]; G])>,
+    ahead: Option<VectorRow<G>>,
 }
 
 impl<const G: usize> VectorRows<G> {
@@ -321,7 +324,7 @@ impl<const G: usize> VectorRows<G> {
     }
 
     /// The next row: its instant and a vector per group.
-    pub(crate) fn next(&mut self) -> Result<Option<(u64, [[f64; 3]; G])>, ColumnError> {
+    pub(crate) fn next(&mut self) -> Result<Option<VectorRow<G>>, ColumnError> {
         if let Some(row) = self.ahead.take() {
             return Ok(Some(row));
         }

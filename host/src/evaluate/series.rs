@@ -60,7 +60,7 @@ impl Series {
                 let t = table.column(if seconds { "t_s" } else { "t_ns" })?;
                 let q = table.columns(["qw", "qx", "qy", "qz"])?;
                 Inner::Csv {
-                    table,
+                    table: Box::new(table),
                     t,
                     q,
                     seconds,
@@ -93,7 +93,7 @@ pub(super) struct Reader<'a>(Inner<'a>);
 enum Inner<'a> {
     Memory(std::slice::Iter<'a, Sample>),
     Csv {
-        table: Table,
+        table: Box<Table>,
         t: usize,
         q: [usize; 4],
         seconds: bool,
