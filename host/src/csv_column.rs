@@ -12,14 +12,15 @@ use std::str::FromStr;
 /// A CSV column that could not be read.
 #[derive(Debug, thiserror::Error, docsplay::Display)]
 pub enum ColumnError {
-    /// {path}: cannot read: {source}
+    /// {path}: cannot read: {cause}
     Read {
         /// The file.
         path: PathBuf,
-        /// The I/O or CSV error.
-        #[source]
-        source: csv::Error,
+        /// The I/O or CSV error (its text is part of the message, so it is not a `source`).
+        cause: csv::Error,
     },
+    /// {0}
+    Input(crate::input_file::InputFileError),
     /// {path}: no column `{column}` in the header (columns: {found})
     MissingColumn {
         /// The file.
@@ -74,9 +75,33 @@ pub fn read<T: TimeStamp>(
     column: &str,
     min_rows: usize,
 ) -> Result<(Vec<T>, Vec<f64>), ColumnError> {
+    let rows = read_checked(path, time, column, min_rows, |_, _| Ok(()))?;
+    Ok((rows.times, rows.values))
+}
+
+/// The rows [`read_checked`] returns.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Rows<T> {
+    /// Times, strictly increasing.
+    pub times: Vec<T>,
+    /// Finite values.
+    pub values: Vec<f64>,
+    /// The 1-based line of each row in the file.
+    pub lines: Vec<u64>,
+}
+
+/// [`read`], with `check(time, value)` refusing a row (its reason is located at the row's
+/// line), and the rows' lines.
+pub fn read_checked<T: TimeStamp>(
+    path: &Path,
+    time: &str,
+    column: &str,
+    min_rows: usize,
+    mut check: impl FnMut(T, f64) -> Result<(), String>,
+) -> Result<Rows<T>, ColumnError> {
     let table = Table::open(path)?;
     let [ti, vi] = table.columns([time, column])?;
-    let (mut times, mut values) = (Vec::<T>::new(), Vec::new());
+    let (mut times, mut values, mut lines) = (Vec::<T>::new(), Vec::new(), Vec::new());
     table.for_each(|row| {
         let (t_text, v_text) = (row.text(ti), row.text(vi));
         let t: T = t_text
@@ -93,8 +118,10 @@ pub fn read<T: TimeStamp>(
         if times.last().is_some_and(|&last| t <= last) {
             return Err(row.error(format!("{time} = {t} does not increase")));
         }
+        check(t, v).map_err(|why| row.error(why))?;
         times.push(t);
         values.push(v);
+        lines.push(row.line());
         Ok(())
     })?;
     if values.len() < min_rows {
@@ -104,7 +131,11 @@ pub fn read<T: TimeStamp>(
             found: values.len(),
         });
     }
-    Ok((times, values))
+    Ok(Rows {
+        times,
+        values,
+        lines,
+    })
 }
 
 #[cfg(test)]

@@ -16,9 +16,9 @@ pub(crate) struct Table {
 impl Table {
     /// Opens `path` and reads its header row.
     pub fn open(path: &Path) -> Result<Self, ColumnError> {
-        let read_err = |source| ColumnError::Read {
+        let read_err = |cause| ColumnError::Read {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
@@ -60,13 +60,13 @@ impl Table {
     /// The next data row, or `None` at the end of the file: a cursor for readers that stream
     /// (one row in memory at a time).
     pub fn next_row(&mut self) -> Result<Option<Row<'_>>, ColumnError> {
-        let more = self
-            .reader
-            .read_record(&mut self.record)
-            .map_err(|source| ColumnError::Read {
-                path: self.path.clone(),
-                source,
-            })?;
+        let more =
+            self.reader
+                .read_record(&mut self.record)
+                .map_err(|cause| ColumnError::Read {
+                    path: self.path.clone(),
+                    cause,
+                })?;
         if !more {
             return Ok(None);
         }

@@ -3,13 +3,16 @@
 //!
 //! Layers, bottom up:
 //! - [`scene`]: the TOML scene file, validated with errors that point at file, line and column;
+//!   [`input_file`]: every file a scene reads is a regular file of bounded size;
 //! - [`reference`](mod@reference): each joint's reference signal (steps, waypoints, sines, random, CSV);
 //! - [`bench`](mod@bench): the closed-loop bench (eq. 5–17): joints, friction, PID synthesis, integrators;
 //! - [`motion`]: static, kinematic or bench motion, so a scene pays only for what it uses;
 //! - [`truth`]: ground truth of the plate (attitude, rates, specific force, field) per sample;
 //! - [`bus`]: embedded-hal 1.0 adapters (SPI, I2C, delay) that put the emulated chip under unmodified drivers;
 //! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
+//! - [`guard`]: the run stops at the first truth or sample value that is not finite;
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
+//! - [`rundir`]: which directory a run writes to, and the completion record written last;
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
 //! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
 //! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
@@ -30,6 +33,8 @@ mod csv_table;
 pub mod demo;
 pub mod dut;
 pub mod evaluate;
+pub mod guard;
+pub mod input_file;
 pub mod loopback;
 pub mod marg;
 pub mod motion;
@@ -38,6 +43,7 @@ pub mod output;
 pub mod perf;
 pub mod reference;
 pub mod run;
+pub mod rundir;
 pub mod scene;
 pub mod stream;
 pub mod truth;

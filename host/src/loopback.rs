@@ -38,7 +38,8 @@ pub struct DeviceReport {
     pub counters: Counters,
     /// Its session state at the end.
     pub state: DeviceState,
-    /// Why the device loop ended (stop flag, end of file, or a port error).
+    /// Why the device loop ended: `stopped` (the stop flag, or the host closed its end after
+    /// the device had stopped), `end of file`, a port error, or the hook's reason.
     pub ended: String,
 }
 
@@ -49,6 +50,12 @@ pub struct LoopbackDevice {
 }
 
 impl LoopbackDevice {
+    /// Whether the device loop has ended by itself (the port closed or failed, or the hook
+    /// ended it).
+    pub fn has_ended(&self) -> bool {
+        self.thread.is_finished()
+    }
+
     /// Stops the device loop and returns its report.
     pub fn stop(self) -> DeviceReport {
         self.stop.store(true, Ordering::Relaxed);
@@ -119,8 +126,13 @@ where
                 if let ControlFlow::Break(why) = hook(&mut device, now()) {
                     break why;
                 }
-                match turn(&mut device, &mut port, now) {
+                let turned = turn(&mut device, &mut port, now);
+                // The host closes its end once its session is over; after the session's Stop
+                // that is how a loopback run ends, whichever of the close and `stop` comes first.
+                let stopped = device.state() == DeviceState::Stopped;
+                match turned {
                     Ok(true) => {}
+                    Ok(false) | Err(_) if stopped => break "stopped".to_owned(),
                     Ok(false) => break "end of file".to_owned(),
                     Err(e) => break format!("port error: {e}"),
                 }

@@ -29,6 +29,8 @@ type HostPerturbation = Perturbation<Vec<Complex>, Vec<f32>>;
 /// The sensor model of one scene, sample by sample.
 pub struct MargSim {
     marg: Marg,
+    /// Samples produced so far (the index of the next one).
+    produced: u64,
     perturbation: Option<HostPerturbation>,
     temperature: Option<[f64; 2]>,
 }
@@ -61,6 +63,7 @@ impl MargSim {
         };
         Ok(Self {
             marg,
+            produced: 0,
             perturbation,
             temperature: spec.sensors.temperature,
         })
@@ -71,8 +74,25 @@ impl MargSim {
         self.perturbation.is_some()
     }
 
+    /// [`Self::sample`], stopped at a value that is not finite ([`crate::guard::check_sample`],
+    /// naming `scene`'s sensor tables).
+    pub fn try_sample(
+        &mut self,
+        scene: &Scene,
+        t: &Truth,
+    ) -> Result<MargSample, Box<crate::guard::NonFinite>> {
+        let index = self.produced;
+        let s = self.sample(t);
+        crate::guard::check_sample(scene, index, &s)?;
+        Ok(s)
+    }
+
     /// The reading for the next output sample, whose truth is `t`.
+    ///
+    /// The model saturates its inputs, so finite truth gives finite samples; callers that
+    /// write or serve samples use [`Self::try_sample`], which checks.
     pub fn sample(&mut self, t: &Truth) -> MargSample {
+        self.produced += 1;
         let disturbance = self.perturbation.as_mut().map_or([0.0; 3], |p| p.sample());
         let f = |v: [f64; 3]| v.map(|x| x as f32);
         let field = f(t.field_body);

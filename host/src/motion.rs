@@ -32,19 +32,8 @@ impl Motion {
             }),
             MotionMode::Kinematic => {
                 let mut refs = Vec::with_capacity(6);
-                for (i, name) in JOINT_NAMES.iter().enumerate() {
-                    let initial = spec.bench.initial[i];
-                    refs.push(match spec.joints.get(*name) {
-                        Some(source) => Reference::build(
-                            source,
-                            name,
-                            initial,
-                            spec.seed,
-                            scene.base_dir(),
-                            true,
-                        )?,
-                        None => Reference::constant(initial),
-                    });
+                for i in 0..JOINT_NAMES.len() {
+                    refs.push(Reference::of_joint(scene, i, true)?);
                 }
                 Motion::Kinematic(Box::new(refs.try_into().expect("six joints")))
             }
@@ -68,6 +57,15 @@ impl Motion {
                 bench.advance_to(t_ns);
                 bench.sample()
             }
+        }
+    }
+
+    /// Joint `i`'s reference (none for a static plate).
+    pub fn reference(&self, i: usize) -> Option<&Reference> {
+        match self {
+            Motion::Static(_) => None,
+            Motion::Kinematic(refs) => Some(&refs[i]),
+            Motion::Bench(bench) => Some(bench.reference_of(i)),
         }
     }
 

@@ -22,6 +22,13 @@
 use crate::truth::Truth;
 use std::io::{self, Write};
 
+/// The files `simulate` writes besides `meta.toml` (`perturbation.csv` only for scenes with a
+/// perturbation).
+pub const RUN_FILES: [&str; 3] = [TRUTH_FILE, "marg.csv", "perturbation.csv"];
+
+/// The ground truth's file, in run and session directories.
+pub const TRUTH_FILE: &str = "truth.csv";
+
 /// Header of `truth.csv`.
 pub const TRUTH_COLUMNS: [&str; 32] = [
     "t_ns", "x", "y", "z", "roll", "pitch", "yaw", "qw", "qx", "qy", "qz", "wx", "wy", "wz", "fx",

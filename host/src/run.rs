@@ -4,22 +4,28 @@
 use crate::bench::{pid::Design, FrictionEvent};
 use crate::marg::{MargSim, MargWriter};
 use crate::motion::Motion;
-use crate::output::{TruthWriter, TRUTH_COLUMNS};
+use crate::output::{TruthWriter, RUN_FILES, TRUTH_COLUMNS};
 use crate::reference::ReferenceError;
+use crate::rundir::{self, Completion, Status};
 use crate::scene::{Scene, JOINT_NAMES};
 use crate::truth::{Truth, TruthModel};
 use serde::Serialize;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A run that failed.
 #[derive(Debug, thiserror::Error, docsplay::Display)]
 pub enum RunError {
-    /// a joint reference could not be built
+    /// the scene's motion failed
     Reference(#[from] ReferenceError),
+    /// {0}
+    NonFinite(Box<crate::guard::NonFinite>),
     /// the sensor model refused the scene: {0}
     Model(margemu_model::Error),
+    /// interrupted; the files hold the samples written so far
+    Interrupted,
     /// cannot write {path}
     Write {
         /// The file.
@@ -40,7 +46,8 @@ pub struct RunSummary {
 }
 
 /// Runs `scene`, calling `sink` with the truth of every output sample in time order and
-/// `progress(done, total)` every 4096 samples.
+/// `progress(done, total)` every 4096 samples. The run stops at the first truth value that is not
+/// finite ([`crate::guard::check_truth`]): [`ReferenceError::NonFinite`].
 pub fn run<E>(
     scene: &Scene,
     mut sink: impl FnMut(&Truth) -> Result<(), E>,
@@ -51,14 +58,25 @@ pub fn run<E>(
     let total = scene.samples();
     // A static plate's truth is the same at every instant but for the time stamp.
     let fixed = match &motion {
-        Motion::Static(pose) => Some(model.compute(0, pose)),
+        Motion::Static(pose) => {
+            let truth = model.compute(0, pose);
+            crate::guard::check_truth(scene, &motion, 0, pose, &truth)
+                .map_err(ReferenceError::NonFinite)?;
+            Some(truth)
+        }
         _ => None,
     };
     for k in 0..total {
         let t_ns = scene.clock.instant(k);
-        let truth = match fixed {
-            Some(truth) => Truth { t_ns, ..truth },
-            None => model.compute(t_ns, &motion.sample_at(t_ns)),
+        let truth = match &fixed {
+            Some(truth) => Truth { t_ns, ..*truth },
+            None => {
+                let joints = motion.sample_at(t_ns);
+                let truth = model.compute(t_ns, &joints);
+                crate::guard::check_truth(scene, &motion, k, &joints, &truth)
+                    .map_err(ReferenceError::NonFinite)?;
+                truth
+            }
         };
         if let Err(e) = sink(&truth) {
             return Ok(Err(e));
@@ -98,47 +116,96 @@ pub fn collect(scene: &Scene) -> Result<Vec<Truth>, ReferenceError> {
 }
 
 /// Runs `scene` and writes `dir/meta.toml`, `dir/truth.csv`, `dir/marg.csv` and, when the
-/// scene has a perturbation, `dir/perturbation.csv` (creating `dir`).
+/// scene has a perturbation, `dir/perturbation.csv` (creating `dir`; choose it with
+/// [`crate::rundir::prepare`]). The CSV files are written under their `.partial` names and
+/// renamed when the run ends; then the completion record is appended to `meta.toml`
+/// ([`crate::rundir`]): complete, interrupted (`stop` was set; the files hold the samples so
+/// far) or failed. A run killed outright leaves `.partial` files and no record.
 pub fn simulate_to_dir(
     scene: &Scene,
     dir: &Path,
+    stop: &AtomicBool,
     progress: impl FnMut(u64, u64),
 ) -> Result<RunSummary, RunError> {
-    let write_err = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| RunError::Write { path, source }
-    };
     std::fs::create_dir_all(dir).map_err(write_err(dir))?;
-    let meta_path = dir.join("meta.toml");
-    std::fs::write(&meta_path, metadata(scene)).map_err(write_err(&meta_path))?;
+    rundir::write_meta(dir, &metadata(scene)).map_err(write_err(&dir.join(rundir::META_FILE)))?;
+    let mut written = 0;
+    let outcome = write_files(scene, dir, stop, &mut written, progress);
+    let (status, ended) = match &outcome {
+        Ok(_) => (Status::Complete, "completed".to_string()),
+        Err(RunError::Interrupted) => (Status::Interrupted, RunError::Interrupted.to_string()),
+        Err(e) => (Status::Failed, e.to_string()),
+    };
+    let completion = Completion {
+        status,
+        samples_written: written,
+        samples_expected: Some(scene.samples()),
+        ended,
+    };
+    let recorded = rundir::write_completion(dir, &completion);
+    let summary = outcome?;
+    recorded.map_err(write_err(&dir.join(rundir::META_FILE)))?;
+    Ok(summary)
+}
+
+fn write_err(path: &Path) -> impl FnOnce(std::io::Error) -> RunError {
+    let path = path.to_path_buf();
+    move |source| RunError::Write { path, source }
+}
+
+/// The CSV files of [`simulate_to_dir`], renamed to their final names once the sample loop
+/// has ended, however it ended (interrupted: whole rows up to the stop; a write error: what
+/// reached the disk); `written` counts the samples written.
+fn write_files(
+    scene: &Scene,
+    dir: &Path,
+    stop: &AtomicBool,
+    written: &mut u64,
+    progress: impl FnMut(u64, u64),
+) -> Result<RunSummary, RunError> {
     let mut marg = MargSim::new(scene).map_err(RunError::Model)?;
+    let [truth_name, marg_name, pert_name] = RUN_FILES;
     let create = |name: &str| -> Result<BufWriter<File>, RunError> {
-        let path = dir.join(name);
+        let path = rundir::partial_path(dir, name);
         let file = File::create(&path).map_err(write_err(&path))?;
         Ok(BufWriter::with_capacity(1 << 20, file))
     };
-    let (truth_path, marg_path) = (dir.join("truth.csv"), dir.join("marg.csv"));
-    let mut truth_out = TruthWriter::new(create("truth.csv")?).map_err(write_err(&truth_path))?;
+    let truth_path = rundir::partial_path(dir, truth_name);
+    let marg_path = rundir::partial_path(dir, marg_name);
+    let mut names = vec![truth_name, marg_name];
+    let mut truth_out = TruthWriter::new(create(truth_name)?).map_err(write_err(&truth_path))?;
     let pert_out = if marg.has_perturbation() {
-        Some(create("perturbation.csv")?)
+        names.push(pert_name);
+        Some(create(pert_name)?)
     } else {
         None
     };
     let mut marg_out =
-        MargWriter::new(create("marg.csv")?, pert_out).map_err(write_err(&marg_path))?;
+        MargWriter::new(create(marg_name)?, pert_out).map_err(write_err(&marg_path))?;
     let sink = |t: &Truth| -> Result<(), RunError> {
+        if stop.load(Ordering::Relaxed) {
+            return Err(RunError::Interrupted);
+        }
         let failed = |path: &PathBuf, source| RunError::Write {
             path: path.clone(),
             source,
         };
         truth_out.write(t).map_err(|e| failed(&truth_path, e))?;
-        marg_out
-            .write(&marg.sample(t))
-            .map_err(|e| failed(&marg_path, e))
+        let sample = marg.try_sample(scene, t).map_err(RunError::NonFinite)?;
+        marg_out.write(&sample).map_err(|e| failed(&marg_path, e))?;
+        *written += 1;
+        Ok(())
     };
-    let summary = run(scene, sink, progress)??;
-    truth_out.finish().map_err(write_err(&truth_path))?;
-    marg_out.finish().map_err(write_err(&marg_path))?;
+    let outcome = run(scene, sink, progress)?;
+    let flushed = truth_out
+        .finish()
+        .map_err(write_err(&truth_path))
+        .and_then(|_| marg_out.finish().map_err(write_err(&marg_path)));
+    for name in names {
+        rundir::commit_partial(dir, name).map_err(write_err(&dir.join(name)))?;
+    }
+    let summary = outcome?;
+    flushed?;
     Ok(summary)
 }
 

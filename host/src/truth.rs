@@ -50,6 +50,27 @@ pub struct Truth {
     pub field_body: [f64; 3],
 }
 
+impl Truth {
+    /// Every value after the time stamp, in the order of the `truth.csv` columns
+    /// ([`crate::output::TRUTH_COLUMNS`] after `t_ns`).
+    pub fn columns(&self) -> [f64; 31] {
+        let [x, y, z] = self.position;
+        let [roll, pitch, yaw] = self.euler;
+        let [qw, qx, qy, qz] = self.quaternion;
+        let [wx, wy, wz] = self.body_rate;
+        let [fx, fy, fz] = self.specific_force;
+        let [vx, vy, vz] = self.velocity;
+        let [awx, awy, awz] = self.accel_world;
+        let [abx, aby, abz] = self.accel_body;
+        let [dwx, dwy, dwz] = self.angular_accel;
+        let [mx, my, mz] = self.field_body;
+        [
+            x, y, z, roll, pitch, yaw, qw, qx, qy, qz, wx, wy, wz, fx, fy, fz, vx, vy, vz, awx,
+            awy, awz, abx, aby, abz, dwx, dwy, dwz, mx, my, mz,
+        ]
+    }
+}
+
 /// Turns joint samples into ground truth for one scene's field and gravity.
 #[derive(Clone, Copy, Debug)]
 pub struct TruthModel {
@@ -160,4 +181,44 @@ pub fn geodesic_angle(q1: &[f64; 4], q2: &[f64; 4]) -> f64 {
     let y = w1 * y2 + x1 * z2 - y1 * w2 - z1 * x2;
     let z = w1 * z2 - x1 * y2 + y1 * x2 - z1 * w2;
     2.0 * libm::atan2(libm::sqrt(x * x + y * y + z * z), w.abs())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `columns` follows the order `truth.csv` is written in.
+    #[test]
+    fn columns_follow_the_written_order() {
+        let mut t = Truth::default();
+        let mut next = 0.0;
+        let mut fill = |v: &mut [f64]| {
+            for x in v {
+                next += 1.0;
+                *x = next;
+            }
+        };
+        fill(&mut t.position);
+        fill(&mut t.euler);
+        fill(&mut t.quaternion);
+        fill(&mut t.body_rate);
+        fill(&mut t.specific_force);
+        fill(&mut t.velocity);
+        fill(&mut t.accel_world);
+        fill(&mut t.accel_body);
+        fill(&mut t.angular_accel);
+        fill(&mut t.field_body);
+        let mut w = crate::output::TruthWriter::new(Vec::new()).unwrap();
+        w.write(&t).unwrap();
+        let text = String::from_utf8(w.finish().unwrap()).unwrap();
+        let row: Vec<f64> = text
+            .lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert_eq!(row, t.columns().to_vec());
+    }
 }

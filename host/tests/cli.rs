@@ -56,16 +56,17 @@ fn same_scene_and_seed_give_byte_identical_files() {
     std::fs::create_dir_all(&other).unwrap();
     let scene = other.join("case-study-2022.toml");
     std::fs::write(&scene, text).unwrap();
+    let run = other.join("run");
     let out = margemu(&[
         "simulate",
         scene.to_str().unwrap(),
         "-o",
-        other.to_str().unwrap(),
+        run.to_str().unwrap(),
     ]);
     assert!(out.status.success());
     assert_ne!(
         std::fs::read(a.join("truth.csv")).unwrap(),
-        std::fs::read(other.join("truth.csv")).unwrap()
+        std::fs::read(run.join("truth.csv")).unwrap()
     );
 }
 

@@ -105,10 +105,11 @@ fn the_measured_noise_density_matches_the_scene() {
 
 #[test]
 fn analyze_noise_reads_a_simulated_run_and_draws_it() {
-    let dir = std::env::temp_dir().join(format!("margemu-analyze-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let scene_path = dir.join("noise.toml");
+    let work = std::env::temp_dir().join(format!("margemu-analyze-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&work);
+    std::fs::create_dir_all(&work).unwrap();
+    let scene_path = work.join("noise.toml");
+    let dir = work.join("run");
     std::fs::write(
         &scene_path,
         "duration = 200.0\nrate = 200.0\nseed = 5\nmotion = \"static\"\n[sensors.gyro]\nnoise_density = [0.01, 0.01, 0.01]\n",
@@ -189,10 +190,11 @@ fn bad_sensor_sections_are_located() {
 
 #[test]
 fn analyze_noise_takes_t_s_as_the_time_column_like_filter() {
-    let dir = std::env::temp_dir().join(format!("margemu-analyze-t-s-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let scene_path = dir.join("noise.toml");
+    let work = std::env::temp_dir().join(format!("margemu-analyze-t-s-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&work);
+    std::fs::create_dir_all(&work).unwrap();
+    let scene_path = work.join("noise.toml");
+    let dir = work.join("run");
     std::fs::write(
         &scene_path,
         "duration = 20.0\nrate = 200.0\nseed = 5\nmotion = \"static\"\n[sensors.gyro]\nnoise_density = [0.01, 0.01, 0.01]\n",

@@ -231,3 +231,67 @@ fn chip_table_resolves_with_defaults() {
     assert_eq!((fs.accel_g, fs.gyro_dps), (4.0, 500.0));
     assert_eq!(chip.to_chip([1.0, 2.0, 3.0]), [2.0, 1.0, -3.0]);
 }
+
+/// Finite values outside their plausible range are refused with the value and the range.
+#[test]
+fn implausible_values_show_the_value_and_the_range() {
+    assert_error(
+        &format!("{BASE}[bench]\ngravity = 5000.0\n"),
+        "5:11",
+        "`bench.gravity`: 5000 is outside the plausible range [0, 1000] m/s²",
+    );
+    assert_error(
+        &format!("{BASE}[sensors.gyro]\nbias = [0.0, 2e7, 0.0]\n"),
+        "5:14",
+        "`sensors.gyro.bias[1]`: 2e7 is outside the plausible range [-1e6, 1e6]",
+    );
+    assert_error(
+        &format!("{BASE}[sensors]\ntemperature = [25.0, 5000.0]\n"),
+        "5:22",
+        "`sensors.temperature[1]`: 5000 is outside the plausible range [-1000, 1000] °C/s",
+    );
+    assert_error(
+        &format!("{BASE}[perturbation]\namplitude = [0.0, 1e9]\n"),
+        "5:19",
+        "`perturbation.amplitude[1]`: 1e9 is outside the plausible range [0, 1e6] field unit",
+    );
+    assert_error(
+        &format!("{BASE}[joints.roll]\ntype = \"sine\"\namplitude = 0.1\nfrequency = 2e6\n"),
+        "7:13",
+        "`joints.roll.frequency`: 2e6 is outside the plausible range [0, 1e6] Hz",
+    );
+    assert_error(
+        &format!("{BASE}[control]\novershoot = [0.2, 0.2, 1.5, 0.4, 0.4, 0.4]\n"),
+        "5:24",
+        "`control.overshoot[2]`: must be in (0, 1), not 1.5",
+    );
+}
+
+/// Scenes that are not regular files are refused by their type, before anything opens them.
+#[test]
+fn a_scene_must_be_a_regular_file() {
+    let e = Scene::load(Path::new("/dev/zero")).unwrap_err().to_string();
+    assert_eq!(e, "/dev/zero: is a character device, not a regular file");
+    let e = Scene::load(Path::new("/")).unwrap_err().to_string();
+    assert_eq!(e, "/: is a directory, not a regular file");
+}
+
+/// Legal but likely wrong inputs load, with located warnings.
+#[test]
+fn warnings_are_located() {
+    let text = format!(
+        "{BASE}[joints.yaw]\ntype = \"random-sine\"\namplitude = [0.1, 0.2]\n\
+         frequency = [1.0, 70.0]\nsegment = [0.5, 1.0]\n"
+    );
+    let scene = Scene::parse_str(&text, Path::new("w.toml")).unwrap();
+    let warnings: Vec<String> = scene.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        warnings,
+        [
+            "w.toml:7:13: `joints.yaw.frequency`: 70 Hz is above the output Nyquist frequency \
+          50 Hz (rate 100 Hz): the samples alias it"
+        ]
+    );
+    let quiet = Scene::parse_str(BASE, Path::new("q.toml")).unwrap();
+    assert!(quiet.warnings.is_empty());
+}

@@ -2,6 +2,7 @@
 //! the protocol's own `Encoder`, the device's output is decoded with the shared `Accumulator`.
 
 mod common;
+mod fuzz_device;
 mod model;
 mod robustness;
 mod session;

@@ -107,14 +107,8 @@ impl Bench {
         let (masses, loads) = masses_and_loads(scene);
         let designs = designs(scene);
         let mut references = Vec::with_capacity(6);
-        for (i, name) in JOINT_NAMES.iter().enumerate() {
-            let initial = spec.bench.initial[i];
-            references.push(match spec.joints.get(*name) {
-                Some(source) => {
-                    Reference::build(source, name, initial, spec.seed, scene.base_dir(), false)?
-                }
-                None => Reference::constant(initial),
-            });
+        for i in 0..JOINT_NAMES.len() {
+            references.push(Reference::of_joint(scene, i, false)?);
         }
         let references: [Reference; 6] = references.try_into().expect("six joints");
         let joints = std::array::from_fn(|i| {
@@ -175,6 +169,11 @@ impl Bench {
     /// Every friction mode change so far.
     pub fn friction_log(&self) -> &[FrictionEvent] {
         &self.friction_log
+    }
+
+    /// Joint `i`'s reference source.
+    pub fn reference_of(&self, i: usize) -> &Reference {
+        &self.references[i]
     }
 
     /// The raw reference of joint `i` at the current time.

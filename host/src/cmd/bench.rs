@@ -47,7 +47,7 @@ impl Cmd {
         match self {
             Cmd::Integrators { scene, seconds } => {
                 let scene = match scene {
-                    Some(p) => Scene::load(&p)?,
+                    Some(p) => super::load_scene(&p)?,
                     None => builtin(FIGURE3, "figure3.toml (built in)")?,
                 };
                 if scene.spec.motion != MotionMode::Bench {

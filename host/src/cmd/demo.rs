@@ -10,18 +10,16 @@ use margemu::scene::Scene;
 use margemu::tune::{self as tuner, Dataset, TuneOptions};
 use margemu::vfc::describe;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 #[derive(clap::Args)]
 pub struct Cmd {
     /// The scene (default: the paper's case study).
     #[arg(long, default_value = "hil-fixtures/scenes/case-study.toml")]
     scene: PathBuf,
-    /// Output directory: one session per run (`<filter>-<initial|tuned>/`, with report.md and
-    /// figures) and table3.md.
-    #[arg(short, long, default_value = "demo")]
-    output: PathBuf,
+    // One session per run (`<filter>-<initial|tuned>/`, with report.md and figures) and
+    // table3.md; default: demo/, numbered if taken.
+    #[command(flatten)]
+    output: super::OutputArgs,
     /// Shorten the scene to this many seconds (each run streams in real time).
     #[arg(long, value_name = "S")]
     duration: Option<f64>,
@@ -91,21 +89,20 @@ fn from_tuner(seeds: usize, max_evals: usize) -> Box<demo::Tuned<'static>> {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let mut scene = Scene::load(&self.scene)?;
+        let interrupt = super::Interrupt::install()?;
+        let mut scene = super::load_scene(&self.scene)?;
         if let Some(seconds) = self.duration {
             if !(seconds.is_finite() && seconds > 0.0) {
                 bail!("--duration must be > 0 s, not {seconds}");
             }
             scene = demo::shorten(&scene, seconds)?;
         }
+        let out = self.output.prepare_or(Path::new("demo"))?;
         let mut tuned = match &self.tuned {
             Some(path) => from_file(path)?,
             None => from_tuner(self.seeds, self.max_evals),
         };
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = stop.clone();
-        ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
-            .context("installing the Ctrl-C handler")?;
+        let stop = interrupt.flag();
         let (over, n, max) = demo::gyro_clipping(&scene)?;
         println!(
             "demo: {} ({} s at {} Hz) through loopback with the virtual flight controller: {} run(s) in real time",
@@ -120,7 +117,7 @@ impl Cmd {
         );
         let options = DemoOptions {
             scene,
-            out: self.output.clone(),
+            out: out.clone(),
             filters: self.filters.clone(),
             plots: !self.no_plots,
         };
@@ -158,7 +155,7 @@ impl Cmd {
                 println!("{line}");
             }
         }
-        let md = self.output.join("table3.md");
+        let md = out.join(table::FILE);
         std::fs::write(&md, table::render(&runs, true))
             .with_context(|| format!("writing {}", md.display()))?;
         println!("wrote {}", md.display());

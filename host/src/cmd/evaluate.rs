@@ -56,6 +56,10 @@ pub struct Cmd {
     /// Skip the figures.
     #[arg(long)]
     no_plots: bool,
+    /// Score a run that did not complete (killed, interrupted or failed: meta.toml's
+    /// completion record); the report then says so.
+    #[arg(long)]
+    allow_incomplete: bool,
 }
 
 fn ms_to_ns(name: &str, ms: f64) -> Result<u64> {
@@ -122,6 +126,7 @@ impl Cmd {
                 magnetic_fraction: self.mag_threshold,
                 window_ns: ms_to_ns("window", self.window)?,
             },
+            allow_incomplete: self.allow_incomplete,
         };
         let out = self.out.unwrap_or(default_out);
         let eval =

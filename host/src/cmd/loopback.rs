@@ -8,7 +8,6 @@ use super::stream::{finish_dut, prepare, stream_to, ChipArgs, DutArgs, SourceArg
 use super::vfc::VfcArgs;
 use anyhow::{bail, Context, Result};
 use margemu::dut::{DutConfig, DutProtocol};
-use margemu::scene::Scene;
 use margemu::stream::{ImageSettings, StreamConfig};
 use serialport::{SerialPort, TTYPort};
 use std::path::PathBuf;
@@ -17,9 +16,9 @@ use std::path::PathBuf;
 pub struct Cmd {
     /// The scene file (TOML).
     scene: PathBuf,
-    /// Session directory (default: sessions/<scene name>-loopback).
-    #[arg(short, long)]
-    output: Option<PathBuf>,
+    // Default: sessions/<scene name>-loopback.
+    #[command(flatten)]
+    output: super::OutputArgs,
     #[command(flatten)]
     chip: ChipArgs,
     #[command(flatten)]
@@ -27,22 +26,23 @@ pub struct Cmd {
     #[command(flatten)]
     dut: DutArgs,
     #[command(flatten)]
+    size: super::SizeArgs,
+    #[command(flatten)]
     vfc: VfcArgs,
 }
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = self.chip.apply(Scene::load(&self.scene)?)?;
-        let dir = self.output.clone().unwrap_or_else(|| {
-            let stem = self.scene.file_stem().unwrap_or_default().to_string_lossy();
-            PathBuf::from("sessions").join(format!("{stem}-loopback"))
-        });
+        let interrupt = super::Interrupt::install()?;
+        let scene = self.chip.apply(super::load_scene(&self.scene)?)?;
+        self.size.check(&scene)?;
         let vfc = self.vfc.config(&scene)?;
         let settings = match vfc {
             Some(_) => margemu::vfc::image_settings(&scene)?,
             None => ImageSettings::for_scene(&scene),
         };
         let (host_end, device_end) = TTYPort::pair().context("opening a pseudo-terminal pair")?;
+        let dir = self.output.prepare(&self.scene, "sessions", "-loopback")?;
         let label = device_end
             .name()
             .unwrap_or_else(|| "a pseudo-terminal".into());
@@ -53,6 +53,7 @@ impl Cmd {
             ..StreamConfig::default()
         };
         let mut session = prepare(&scene, config, &dir)?;
+        interrupt.watch(session.stop_flag());
         let (device, dut) = match vfc {
             Some(cfg) => {
                 let expected = settings.chip;

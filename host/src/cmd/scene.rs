@@ -1,8 +1,9 @@
-//! `margemu scene check SCENE`: validate a scene and print the derived PID gains.
+//! `margemu scene check SCENE`: validate a scene (its CSV sources too), print its warnings (to
+//! stderr), its run, its size and the derived PID gains.
 
 use anyhow::Result;
 use margemu::bench::{designs, masses_and_loads};
-use margemu::scene::{Scene, JOINT_NAMES};
+use margemu::scene::JOINT_NAMES;
 use std::path::PathBuf;
 
 #[derive(clap::Subcommand)]
@@ -17,8 +18,7 @@ pub enum Cmd {
 impl Cmd {
     pub fn run(self) -> Result<()> {
         let Cmd::Check { scene } = self;
-        let scene = Scene::load(&scene)?;
-        margemu::motion::Motion::new(&scene)?; // CSV sources are read and checked here.
+        let scene = super::load_scene(&scene)?;
         let spec = &scene.spec;
         println!(
             "ok: {}: {} samples at {} Hz over {} s, motion {:?}, {:?} integrator with {} s steps, seed {}",
@@ -31,6 +31,16 @@ impl Cmd {
             spec.integrator.step,
             spec.seed
         );
+        let size = margemu::scene::size::estimate(&scene);
+        println!("size: {size}");
+        if size.is_large() {
+            println!(
+                "beyond the limit of {} samples and {} of output: simulate, loopback and stream \
+                 need --allow-large",
+                margemu::scene::size::MAX_SAMPLES,
+                margemu::scene::size::bytes(margemu::scene::size::MAX_OUTPUT_BYTES)
+            );
+        }
         if spec.motion != margemu::scene::MotionMode::Bench {
             println!("no dynamics in {:?} mode: no PID gains", spec.motion);
             return Ok(());

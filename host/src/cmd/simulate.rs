@@ -1,23 +1,30 @@
-//! `margemu simulate SCENE -o DIR`: run a scene and write its run directory.
+//! `margemu simulate SCENE [-o DIR] [--force]`: run a scene and write its run directory
+//! (default `runs/<scene name>`, numbered if taken: [`margemu::rundir`]).
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use margemu::scene::Scene;
 use std::path::PathBuf;
+
+use super::OutputArgs;
 use std::time::{Duration, Instant};
 
 #[derive(clap::Args)]
 pub struct Cmd {
     /// The scene file (TOML).
     scene: PathBuf,
-    /// Output directory (created if missing; existing files are replaced).
-    #[arg(short, long)]
-    output: PathBuf,
+    // Default: runs/<scene name>.
+    #[command(flatten)]
+    output: OutputArgs,
+    #[command(flatten)]
+    size: super::SizeArgs,
 }
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = Scene::load(&self.scene)?;
+        let stop = super::Interrupt::install()?.flag();
+        let scene = super::load_scene(&self.scene)?;
+        self.size.check(&scene)?;
+        let dir = self.output.prepare(&self.scene, "runs", "")?;
         let bar =
             ProgressBar::with_draw_target(Some(scene.samples()), ProgressDrawTarget::hidden());
         bar.set_style(
@@ -34,7 +41,7 @@ impl Cmd {
             }
             bar.set_position(done);
         };
-        let summary = margemu::run::simulate_to_dir(&scene, &self.output, progress)
+        let summary = margemu::run::simulate_to_dir(&scene, &dir, &stop, progress)
             .with_context(|| format!("simulating {}", scene.path.display()))?;
         bar.finish_and_clear();
         println!(
@@ -42,7 +49,7 @@ impl Cmd {
             summary.samples,
             scene.spec.duration,
             scene.clock.hz(),
-            self.output.display(),
+            dir.display(),
             start.elapsed().as_secs_f64()
         );
         if !summary.friction_events.is_empty() {

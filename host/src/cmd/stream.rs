@@ -21,9 +21,9 @@ pub struct Cmd {
     /// Line rate (ignored by USB CDC and pseudo-terminals).
     #[arg(long, default_value_t = 921_600)]
     baud: u32,
-    /// Session directory (default: sessions/<scene name>).
-    #[arg(short, long)]
-    output: Option<PathBuf>,
+    // Default: sessions/<scene name>.
+    #[command(flatten)]
+    output: super::OutputArgs,
     /// Write each batch this many milliseconds before its first sample's instant (at most 3/8
     /// of the device's buffer).
     #[arg(long, default_value_t = 200.0)]
@@ -40,6 +40,8 @@ pub struct Cmd {
     source: SourceArgs,
     #[command(flatten)]
     dut: DutArgs,
+    #[command(flatten)]
+    size: super::SizeArgs,
 }
 
 /// Which chip the device emulates.
@@ -136,11 +138,9 @@ impl SourceArgs {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = self.chip.apply(Scene::load(&self.scene)?)?;
-        let dir = self.output.clone().unwrap_or_else(|| {
-            let stem = self.scene.file_stem().unwrap_or_default();
-            PathBuf::from("sessions").join(stem)
-        });
+        let interrupt = super::Interrupt::install()?;
+        let scene = self.chip.apply(super::load_scene(&self.scene)?)?;
+        self.size.check(&scene)?;
         let mut images = margemu::stream::ImageSettings::for_scene(&scene);
         if let Some(v) = self.mag_ut_per_unit {
             anyhow::ensure!(v.is_finite() && v > 0.0, "--mag-ut-per-unit must be > 0");
@@ -163,7 +163,9 @@ impl Cmd {
         };
         let port =
             open_port(&self.port, self.baud).with_context(|| format!("opening {}", self.port))?;
+        let dir = self.output.prepare(&self.scene, "sessions", "")?;
         let mut session = prepare(&scene, config, &dir)?;
+        interrupt.watch(session.stop_flag());
         let dut = self.dut.attach(&mut session, &dir)?;
         let streamed = stream_to(&scene, session, &dir, port, &self.port);
         let dut = dut.map(finish_dut).transpose();
@@ -196,7 +198,8 @@ pub fn prepare(scene: &Scene, config: StreamConfig, dir: &std::path::Path) -> Re
 }
 
 /// Runs `session` of `scene` over `port` (named `label` in messages) with a progress line,
-/// prints the summary, and returns it; the session directory is `dir`.
+/// prints the summary, and returns it; the session directory is `dir`. The caller hands the
+/// session's stop flag to its [`super::Interrupt`].
 pub fn stream_to(
     scene: &Scene,
     session: Session,
@@ -205,9 +208,6 @@ pub fn stream_to(
     label: &str,
 ) -> Result<margemu::stream::Summary> {
     eprintln!("image settings: {:?}", session.image_settings());
-    let stop = session.stop_flag();
-    ctrlc::set_handler(move || stop.store(true, std::sync::atomic::Ordering::Relaxed))
-        .context("installing the Ctrl-C handler")?;
     let bar = ProgressBar::new(session.samples().len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),

@@ -5,7 +5,6 @@
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use margemu::offline::FilterKind;
-use margemu::scene::Scene;
 use margemu::tune::{self, report, AttitudeStart, Dataset, Objective, TuneOptions};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -40,7 +39,7 @@ pub struct Cmd {
 
 impl Cmd {
     pub fn run(self) -> Result<()> {
-        let scene = Scene::load(&self.scene)?;
+        let scene = super::load_scene(&self.scene)?;
         let start = Instant::now();
         let data = Dataset::simulate(&scene, self.seeds)
             .with_context(|| format!("simulating {}", scene.path.display()))?;

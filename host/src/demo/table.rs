@@ -62,6 +62,9 @@ fn paper(row: &PaperRow, kind: FilterKind, variant: Variant) -> f64 {
     row.paper[k][usize::from(variant == Variant::Tuned)]
 }
 
+/// The table's file in the demo's directory.
+pub const FILE: &str = "table3.md";
+
 /// The table: one column per run, each cell `ours (paper)`; `markdown` for `table3.md`.
 pub fn render(runs: &[DemoRun], markdown: bool) -> String {
     let header: Vec<String> = runs

@@ -21,6 +21,9 @@ pub const ATTITUDE_FILE: &str = "dut_attitude.csv";
 /// See [`MESSAGES_FILE`].
 pub const IMU_FILE: &str = "dut_imu.csv";
 
+/// Every file of the device under test's log.
+pub const FILES: [&str; 3] = [MESSAGES_FILE, ATTITUDE_FILE, IMU_FILE];
+
 /// The open CSV files.
 pub struct DutLog {
     messages: BufWriter<File>,

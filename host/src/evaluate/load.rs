@@ -46,29 +46,35 @@ pub(super) struct Loaded {
 
 /// Reads `source`.
 pub(super) fn load(source: &Source, options: &EvalOptions) -> Result<Loaded, EvalError> {
-    if let Source::Session(dir) | Source::Estimates { dir, .. } = source {
-        run_directory(dir)?;
-    }
-    match source {
+    let incomplete = match source {
+        Source::Session(dir) | Source::Estimates { dir, .. } => run_directory(dir, options)?,
+        Source::External { .. } => None,
+    };
+    let mut loaded = match source {
         Source::Session(dir) => load_session(dir, options),
         Source::Estimates { dir, estimates } => load_run(dir, estimates, &options.rules),
         Source::External { file, estimates } => {
             load_external(file, estimates.as_deref(), &options.rules)
         }
-    }
+    }?;
+    loaded.notes.extend(incomplete);
+    Ok(loaded)
 }
 
-/// Checks a run or session directory as a whole before any of its files is read: the one place
-/// for such checks.
-fn run_directory(dir: &Path) -> Result<(), EvalError> {
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(EvalError::Input {
+/// Checks a run or session directory as a whole before any of its files is read (the one place
+/// for such checks): that it is one, and that its run completed
+/// ([`crate::rundir::check_complete`]); with `allow_incomplete`, the note saying it did not.
+fn run_directory(dir: &Path, options: &EvalOptions) -> Result<Option<String>, EvalError> {
+    if !dir.is_dir() {
+        return Err(EvalError::Input {
             path: dir.to_path_buf(),
             reason: "no such directory".into(),
-        })
+        });
     }
+    Ok(crate::rundir::check_complete(
+        dir,
+        options.allow_incomplete,
+    )?)
 }
 
 fn norm(v: &[f64; 3]) -> f64 {

@@ -179,6 +179,16 @@ pub fn markdown(eval: &Evaluation, dir: &Path, figures: &[PathBuf]) -> String {
     md
 }
 
+/// Every file [`write()`] and [`evaluate_writing`](super::run::evaluate_writing) may write.
+pub const FILES: [&str; 6] = [
+    "errors.csv",
+    "report.md",
+    "attitude.png",
+    "attitude.svg",
+    "alignment.png",
+    "alignment.svg",
+];
+
 /// The columns of `errors.csv`.
 pub const ERRORS_HEADER: &str =
     "t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic";

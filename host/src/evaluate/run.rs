@@ -64,6 +64,9 @@ pub struct EvalOptions {
     pub device_time: bool,
     /// Phase thresholds.
     pub rules: PhaseRules,
+    /// Score a run directory whose completion record is missing or not `complete`
+    /// ([`crate::rundir::check_complete`]), with a note saying so, instead of refusing it.
+    pub allow_incomplete: bool,
 }
 
 impl Default for EvalOptions {
@@ -74,6 +77,7 @@ impl Default for EvalOptions {
             message: None,
             device_time: true,
             rules: PhaseRules::default(),
+            allow_incomplete: false,
         }
     }
 }
@@ -102,6 +106,8 @@ pub enum EvalError {
     },
     /// {0}
     Plot(crate::analysis::plot::PlotError),
+    /// {0}
+    RunDir(#[from] crate::rundir::RunDirError),
     /// {path}: cannot write: {error}
     Write {
         /// The file.

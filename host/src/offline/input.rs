@@ -231,9 +231,9 @@ impl External {
             .from_reader(std::io::BufReader::new(file));
         let header = reader
             .headers()
-            .map_err(|source| ColumnError::Read {
+            .map_err(|cause| ColumnError::Read {
                 path: path.to_path_buf(),
-                source,
+                cause,
             })?
             .clone();
         if let Some(missing) = COLUMNS.iter().find(|c| !header.iter().any(|h| h == **c)) {
@@ -254,13 +254,13 @@ impl External {
 
     fn next(&mut self) -> Result<Option<Sample>, InputError> {
         let path = &self.path;
-        let more = self
-            .reader
-            .read_record(&mut self.record)
-            .map_err(|source| ColumnError::Read {
-                path: path.clone(),
-                source,
-            })?;
+        let more =
+            self.reader
+                .read_record(&mut self.record)
+                .map_err(|cause| ColumnError::Read {
+                    path: path.clone(),
+                    cause,
+                })?;
         if !more {
             return Ok(None);
         }

@@ -20,7 +20,7 @@
 mod piecewise;
 mod table;
 
-use crate::scene::SourceSpec;
+use crate::scene::{Scene, SourceSpec, JOINT_NAMES};
 use piecewise::Piecewise;
 use std::path::{Path, PathBuf};
 pub use table::{Table, TableError};
@@ -28,17 +28,21 @@ pub use table::{Table, TableError};
 /// Value, first and second derivative (per second, per second²).
 pub type Derivatives = [f64; 3];
 
-/// A reference that could not be built.
+/// A scene's motion that could not be produced: a joint reference that could not be built, or
+/// a value that went non-finite while the motion ran.
 #[derive(Debug, thiserror::Error, docsplay::Display)]
 pub enum ReferenceError {
-    /// joint `{joint}`: {source}
+    /// {at}: joint `{joint}`: {problem}
     Table {
+        /// The scene's `file:line:col` of the source's `file` key.
+        at: String,
         /// Joint name.
         joint: String,
-        /// The CSV problem.
-        #[source]
-        source: TableError,
+        /// The CSV problem (its text is part of the message, so it is not a `source`).
+        problem: Box<TableError>,
     },
+    /// {0}
+    NonFinite(Box<crate::guard::NonFinite>),
 }
 
 /// One joint's reference signal.
@@ -74,7 +78,7 @@ impl Reference {
         seed: u64,
         base: &Path,
         smooth: bool,
-    ) -> Result<Self, ReferenceError> {
+    ) -> Result<Self, TableError> {
         let kind = match spec {
             SourceSpec::Constant { value } => Kind::Constant(*value),
             SourceSpec::Sine {
@@ -91,10 +95,7 @@ impl Reference {
             SourceSpec::Polynomial { coefficients } => Kind::Polynomial(coefficients.clone()),
             SourceSpec::Csv { file, column, .. } => {
                 let path: PathBuf = base.join(file);
-                let table = Table::load(&path, column).map_err(|source| ReferenceError::Table {
-                    joint: joint.into(),
-                    source,
-                })?;
+                let table = Table::load(&path, column)?;
                 if smooth {
                     Kind::Spline(table.into_spline())
                 } else {
@@ -107,6 +108,30 @@ impl Reference {
             kind,
             memo: (f64::NAN, 0.0),
         })
+    }
+
+    /// Joint `i`'s reference in `scene` (its source, or its initial value held), with CSV
+    /// problems located at the scene's `joints.<name>.file`. `smooth` as for [`Self::build`].
+    pub fn of_joint(scene: &Scene, i: usize, smooth: bool) -> Result<Self, ReferenceError> {
+        let (spec, name) = (&scene.spec, JOINT_NAMES[i]);
+        let initial = spec.bench.initial[i];
+        match spec.joints.get(name) {
+            None => Ok(Self::constant(initial)),
+            Some(source) => Self::build(source, name, initial, spec.seed, scene.base_dir(), smooth)
+                .map_err(|problem| ReferenceError::Table {
+                    at: scene.location(&["joints", name, "file"]),
+                    joint: name.into(),
+                    problem: Box::new(problem),
+                }),
+        }
+    }
+
+    /// For a CSV source, the file and rows in force at `t_ns` (see [`Table::rows_at`]).
+    pub fn rows_at(&self, t_ns: f64) -> Option<String> {
+        match &self.kind {
+            Kind::Linear(t) | Kind::Spline(t) => t.rows_at(seconds(t_ns)),
+            _ => None,
+        }
     }
 
     /// A constant reference.

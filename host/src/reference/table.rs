@@ -2,8 +2,13 @@
 //! and a named value column. Between rows the value is interpolated linearly (bench setpoints)
 //! or by a natural cubic spline (kinematic mode, which needs continuous acceleration). Before
 //! the first row the first value holds, after the last row the last value holds.
+//!
+//! The file must be a regular file within [`crate::input_file::MAX_INPUT_BYTES`]; times must
+//! lie in [`SOURCE_TIME`] and values in [`JOINT_VALUE`] (plausible ranges, refused at their
+//! line).
 
 use super::Derivatives;
+use crate::scene::ranges::{JOINT_VALUE, SOURCE_TIME};
 use std::path::Path;
 
 /// A CSV reference file that could not be used.
@@ -16,17 +21,41 @@ pub struct Table {
     y: Vec<f64>,
     /// Spline second derivatives at the knots (empty for linear use).
     m: Vec<f64>,
+    /// The file and each row's line, for tables read from a file.
+    origin: Option<(std::path::PathBuf, Vec<u64>)>,
 }
 
 impl Table {
     /// Loads column `column` against column `t` from `path`.
     pub fn load(path: &Path, column: &str) -> Result<Self, TableError> {
-        let (t, y) = crate::csv_column::read::<f64>(path, "t", column, 1)?;
+        crate::input_file::check(path).map_err(TableError::Input)?;
+        let rows = crate::csv_column::read_checked::<f64>(path, "t", column, 1, |t, v| {
+            if !SOURCE_TIME.contains(t) {
+                return Err(format!("`t` = {}", SOURCE_TIME.refusal(t)));
+            }
+            if !JOINT_VALUE.contains(v) {
+                return Err(format!("`{column}` = {}", JOINT_VALUE.refusal(v)));
+            }
+            Ok(())
+        })?;
         Ok(Self {
-            t,
-            y,
+            t: rows.times,
+            y: rows.values,
             m: Vec::new(),
+            origin: Some((path.to_path_buf(), rows.lines)),
         })
+    }
+
+    /// `file:line` of the rows in force at time `x` (s): the row before and the row after, or
+    /// the first or last row outside the table; `None` for a table not read from a file.
+    pub fn rows_at(&self, x: f64) -> Option<String> {
+        let (path, lines) = self.origin.as_ref()?;
+        let rows = match self.interval(x) {
+            Some(i) => format!("lines {}–{}", lines[i], lines[i + 1]),
+            None if x < self.t[0] => format!("line {}", lines[0]),
+            None => format!("line {}", lines[lines.len() - 1]),
+        };
+        Some(format!("{} {rows}", path.display()))
     }
 
     /// A table from samples (times strictly increasing, at least one).
@@ -35,6 +64,7 @@ impl Table {
             t,
             y,
             m: Vec::new(),
+            origin: None,
         }
     }
 

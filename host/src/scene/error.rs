@@ -25,6 +25,16 @@ impl fmt::Display for SceneError {
     }
 }
 
+/// A legal but likely wrong input, located like an error.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneWarning(pub SceneError);
+
+impl fmt::Display for SceneWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
 /// A validation failure: the key path of the offending value and the reason.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Violation {
@@ -79,11 +89,40 @@ impl Violation {
 }
 
 impl SceneError {
-    pub(crate) fn io(path: &Path, e: &std::io::Error) -> Self {
+    pub(crate) fn input(path: &Path, e: &crate::input_file::InputFileError) -> Self {
         Self {
             file: path.to_path_buf(),
             position: None,
-            reason: format!("cannot read: {e}"),
+            reason: e.reason(),
+        }
+    }
+
+    /// Bytes that are not UTF-8, located at the first invalid byte.
+    pub(crate) fn not_utf8(path: &Path, bytes: &[u8], e: &std::str::Utf8Error) -> Self {
+        let valid = &bytes[..e.valid_up_to()];
+        let text = std::str::from_utf8(valid).unwrap_or_default();
+        Self {
+            file: path.to_path_buf(),
+            position: Some(line_col(text, text.len())),
+            reason: format!(
+                "byte 0x{:02x} at offset {} is not UTF-8",
+                bytes[e.valid_up_to()],
+                e.valid_up_to()
+            ),
+        }
+    }
+
+    /// An error at the value of the key path `keys` (or its nearest ancestor in the file).
+    pub(crate) fn at_keys(path: &Path, text: &str, keys: &[&str], reason: String) -> Self {
+        Self::from_violation(path, text, Violation::at(keys, reason))
+    }
+
+    /// `file:line:col` of the value at the key path `keys`, or `file` alone.
+    pub(crate) fn location(path: &Path, text: &str, keys: &[&str]) -> String {
+        let v = Violation::at(keys, "");
+        match locate(text, &v.path).map(|at| line_col(text, at)) {
+            Some((line, col)) => format!("{}:{line}:{col}", path.display()),
+            None => path.display().to_string(),
         }
     }
 

@@ -20,11 +20,14 @@
 
 pub mod chip;
 mod error;
+pub mod ranges;
 mod schema;
 pub mod sensors;
+pub mod size;
 mod validate;
+mod warnings;
 
-pub use error::SceneError;
+pub use error::{SceneError, SceneWarning};
 pub use schema::*;
 
 use margemu_model::time::{Nanos, SampleClock};
@@ -47,13 +50,18 @@ pub struct Scene {
     pub step_ns: Nanos,
     /// The emulated chip (`[chip]`, or the default MPU-9250).
     pub chip: chip::ChipSetup,
+    /// Legal but likely wrong inputs, located (commands print them once, to stderr).
+    pub warnings: Vec<SceneWarning>,
 }
 
 impl Scene {
-    /// Reads, parses and validates the scene file at `path`.
+    /// Reads, parses and validates the scene file at `path` (a regular file of at most
+    /// [`crate::input_file::MAX_INPUT_BYTES`], UTF-8).
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError::io(path, &e))?;
-        Self::parse_str(&text, path)
+        let bytes = crate::input_file::read(path).map_err(|e| SceneError::input(path, &e))?;
+        let text =
+            std::str::from_utf8(&bytes).map_err(|e| SceneError::not_utf8(path, &bytes, &e))?;
+        Self::parse_str(text, path)
     }
 
     /// Parses and validates scene text; `path` names it in errors and anchors relative paths.
@@ -62,7 +70,12 @@ impl Scene {
             toml::from_str(text).map_err(|e| SceneError::from_toml(path, text, &e))?;
         let checked =
             validate::check(&spec).map_err(|v| SceneError::from_violation(path, text, v))?;
-        Ok(Self {
+        let warnings = checked
+            .warnings
+            .into_iter()
+            .map(|v| SceneWarning(SceneError::from_violation(path, text, v)))
+            .collect();
+        let scene = Self {
             spec,
             path: path.to_path_buf(),
             text: text.to_owned(),
@@ -70,12 +83,58 @@ impl Scene {
             duration_ns: checked.duration_ns,
             step_ns: checked.step_ns,
             chip: checked.chip,
-        })
+            warnings,
+        };
+        scene.check_gains()?;
+        Ok(scene)
+    }
+
+    /// The PID gains a bench scene derives (or gives) must be finite; they are refused at the
+    /// `[bench]` and `[control]` inputs they come from.
+    fn check_gains(&self) -> Result<(), SceneError> {
+        if self.spec.motion != MotionMode::Bench || self.spec.control.gains.is_some() {
+            return Ok(());
+        }
+        let designs = crate::bench::designs(self);
+        for (i, design) in designs.iter().enumerate() {
+            let Some(d) = design else { continue };
+            let g = d.gains;
+            if [g.kp, g.ki, g.kd, d.time_constant]
+                .iter()
+                .all(|x| x.is_finite())
+            {
+                continue;
+            }
+            let mass_key = if i < 3 { "link_mass" } else { "plate_inertia" };
+            let (masses, _) = crate::bench::masses_and_loads(self);
+            return Err(SceneError::at_keys(
+                &self.path,
+                &self.text,
+                &["bench", mass_key],
+                format!(
+                    "the PID gains of joint {} are not finite (Kp {}, Ki {}, Kd {}) for the                      mass {} from [bench] (link_mass, plate_mass, plate_inertia),                      viscous_friction {} and [control] settling_time {} s",
+                    JOINT_NAMES[i],
+                    g.kp,
+                    g.ki,
+                    g.kd,
+                    ranges::number(masses[i]),
+                    ranges::number(self.spec.bench.viscous_friction[i]),
+                    ranges::number(self.spec.control.settling_time[i]),
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Number of output samples: those latched in `[0, duration)`.
     pub fn samples(&self) -> u64 {
         self.clock.count_before(self.duration_ns)
+    }
+
+    /// `file:line:col` of the value at key path `keys` (or of its nearest ancestor in the
+    /// file), for messages about what that value caused.
+    pub fn location(&self, keys: &[&str]) -> String {
+        SceneError::location(&self.path, &self.text, keys)
     }
 
     /// The folder relative paths in the scene resolve against.
@@ -90,5 +149,32 @@ impl Scene {
             .iter()
             .map(|b| format!("{b:02x}"))
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Gains that overflow are refused at the `[bench]` input they come from (validation's
+    /// ranges keep loaded scenes from getting here; this checks the last line of defence).
+    #[test]
+    fn non_finite_gains_are_refused_at_the_bench() {
+        let text = "duration = 1.0\nrate = 100.0\nseed = 1\n[bench]\nlink_mass = [1.0, 1.0, 1.0]\n";
+        let mut scene = Scene::parse_str(text, Path::new("gains.toml")).unwrap();
+        scene.spec.bench.link_mass = [1e300; 3];
+        scene.spec.bench.plate_mass = 1e308;
+        let e = scene.check_gains().unwrap_err().to_string();
+        assert!(
+            e.starts_with(
+                "gains.toml:5:13: `bench.link_mass`: the PID gains of joint x are not finite \
+                 (Kp inf"
+            ),
+            "{e}"
+        );
+        assert!(
+            e.contains("from [bench] (link_mass, plate_mass, plate_inertia)"),
+            "{e}"
+        );
     }
 }

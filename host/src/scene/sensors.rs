@@ -6,6 +6,7 @@
 //! `[perturbation]` runs no generator at all. Units: gyro rad/s, accel m/s², mag the scene's
 //! field unit; densities per √Hz, random walks per √s, times in s, temperatures in °C.
 
+use super::error::Violation;
 use margemu_model::perturbation::{Amplitude, PerturbationConfig, Placement};
 use margemu_model::sensor::{
     AccelConfig, BiasInstability, GyroConfig, MagConfig, MargConfig, SensorErrors, TemperatureBias,
@@ -219,6 +220,97 @@ impl PerturbationSpec {
             },
         }
     }
+}
+
+/// Finite sensor and perturbation values outside their plausible ranges (the model itself
+/// refuses non-finite ones and those of the wrong sign, with its own messages).
+pub(crate) fn check_ranges(spec: &super::SceneSpec) -> Result<(), Violation> {
+    use super::ranges::{self, Plausible};
+    let check = |xs: &[f64], at: &[&str], range: Plausible| -> Result<(), Violation> {
+        for (i, &x) in xs.iter().enumerate() {
+            if x.is_finite() {
+                range.check(x, at).map_err(|v| v.index(i))?;
+            }
+        }
+        Ok(())
+    };
+    let s = &spec.sensors;
+    for (name, sensor) in [("gyro", &s.gyro), ("accel", &s.accel), ("mag", &s.mag)] {
+        let term = ranges::SENSOR_TERM;
+        let matrices = [
+            ("scale_factor", &sensor.scale_factor),
+            ("misalignment", &sensor.misalignment),
+            ("g_sensitivity", &sensor.g_sensitivity),
+            ("soft_iron", &sensor.soft_iron),
+        ];
+        for (key, m) in matrices {
+            for (row, values) in m.iter().flatten().enumerate() {
+                check(values, &["sensors", name, key], term).map_err(|v| v.index(row))?;
+            }
+        }
+        let vectors = [
+            ("bias", &sensor.bias),
+            ("noise_density", &sensor.noise_density),
+            ("rate_random_walk", &sensor.rate_random_walk),
+            ("resolution", &sensor.resolution),
+            ("range", &sensor.range),
+            ("lever_arm", &sensor.lever_arm),
+            ("hard_iron", &sensor.hard_iron),
+        ];
+        for (key, v) in vectors {
+            if let Some(v) = v {
+                check(v, &["sensors", name, key], term)?;
+            }
+        }
+        if let Some(b) = &sensor.bias_instability {
+            let at = ["sensors", name, "bias_instability"];
+            check(&b.coefficient, &[at[0], at[1], at[2], "coefficient"], term)?;
+            let time = [b.correlation_time];
+            check(
+                &time,
+                &[at[0], at[1], at[2], "correlation_time"],
+                ranges::CORRELATION_TIME,
+            )
+            .map_err(|mut v| {
+                v.path.pop();
+                v
+            })?;
+        }
+        if let Some(t) = &sensor.temperature_bias {
+            let at = ["sensors", name, "temperature_bias"];
+            check(&t.coefficient, &[at[0], at[1], at[2], "coefficient"], term)?;
+            check(
+                &[t.reference],
+                &[at[0], at[1], at[2], "reference"],
+                ranges::TEMPERATURE,
+            )
+            .map_err(|mut v| {
+                v.path.pop();
+                v
+            })?;
+        }
+    }
+    if let Some(p) = &spec.perturbation {
+        let scalar = |x: f64, key: &str, range: Plausible| {
+            if x.is_finite() {
+                range.check(x, &["perturbation", key])
+            } else {
+                Ok(())
+            }
+        };
+        scalar(p.window, "window", ranges::TIME)?;
+        scalar(p.cutoff, "cutoff", ranges::FREQUENCY)?;
+        check(
+            &p.amplitude,
+            &["perturbation", "amplitude"],
+            ranges::PERTURBATION_AMPLITUDE,
+        )?;
+        check(&p.gap, &["perturbation", "gap"], ranges::TIME)?;
+        if let Some(d) = &p.direction {
+            check(d, &["perturbation", "direction"], ranges::SENSOR_TERM)?;
+        }
+    }
+    Ok(())
 }
 
 /// The TOML key path of a model parameter named `what` (e.g. `gyro.noise_density` →

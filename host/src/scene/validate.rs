@@ -2,6 +2,7 @@
 //! integrator steps, and each joint's source allowed in the scene's motion mode.
 
 use super::error::Violation;
+use super::ranges::{self, Plausible};
 use super::schema::*;
 use margemu_model::time::{nanos_from_seconds, Nanos, SampleClock};
 
@@ -11,16 +12,18 @@ pub(crate) struct Checked {
     pub duration_ns: Nanos,
     pub step_ns: Nanos,
     pub chip: super::chip::ChipSetup,
+    /// Legal but likely wrong inputs.
+    pub warnings: Vec<Violation>,
 }
 
 type Check = Result<(), Violation>;
 
 pub(crate) fn check(spec: &SceneSpec) -> Result<Checked, Violation> {
-    let duration_ns = positive_nanos(spec.duration, &["duration"])?;
-    finite_positive(spec.rate, &["rate"])?;
+    let duration_ns = positive_nanos(spec.duration, &["duration"], ranges::TIME)?;
+    finite_positive(spec.rate, &["rate"], ranges::RATE)?;
     let clock = SampleClock::from_hz(spec.rate)
         .ok_or_else(|| Violation::at(&["rate"], "must be between 0.001 Hz and 1 GHz"))?;
-    let step_ns = positive_nanos(spec.integrator.step, &["integrator", "step"])?;
+    let step_ns = positive_nanos(spec.integrator.step, &["integrator", "step"], ranges::STEP)?;
     if duration_ns % step_ns != 0 {
         return Err(Violation::at(
             &["duration"],
@@ -36,7 +39,11 @@ pub(crate) fn check(spec: &SceneSpec) -> Result<Checked, Violation> {
             "shorter than one output sample",
         ));
     }
-    all_finite(&spec.field.reference, &["field", "reference"])?;
+    all_finite(
+        &spec.field.reference,
+        &["field", "reference"],
+        ranges::FIELD,
+    )?;
     check_bench(&spec.bench)?;
     check_control(&spec.control)?;
     for (name, source) in &spec.joints {
@@ -49,6 +56,7 @@ pub(crate) fn check(spec: &SceneSpec) -> Result<Checked, Violation> {
         duration_ns,
         step_ns,
         chip,
+        warnings: super::warnings::collect(spec),
     })
 }
 
@@ -71,8 +79,11 @@ fn check_sensors(spec: &SceneSpec) -> Check {
         }
     }
     if let Some(t) = &sensors.temperature {
-        all_finite(t, &["sensors", "temperature"])?;
+        let at = ["sensors", "temperature"];
+        finite(t[0], &at, ranges::TEMPERATURE).map_err(|v| v.index(0))?;
+        finite(t[1], &at, ranges::TEMPERATURE_SLOPE).map_err(|v| v.index(1))?;
     }
+    super::sensors::check_ranges(spec)?;
     Marg::new(&sensors.config(), spec.rate, spec.seed).map_err(model_violation)?;
     if let Some(p) = &spec.perturbation {
         use super::sensors::PlacementSpec;
@@ -111,57 +122,76 @@ fn model_violation(e: margemu_model::Error) -> Violation {
 }
 
 fn check_bench(b: &BenchSpec) -> Check {
-    all_positive(&b.link_mass, &["bench", "link_mass"], "a mass")?;
-    finite_positive(b.plate_mass, &["bench", "plate_mass"])?;
-    all_positive(&b.plate_inertia, &["bench", "plate_inertia"], "an inertia")?;
-    all_non_negative(&b.viscous_friction, &["bench", "viscous_friction"])?;
-    all_non_negative(&b.static_friction, &["bench", "static_friction"])?;
+    let at = |key| ["bench", key];
+    all_positive(&b.link_mass, &at("link_mass"), "a mass", ranges::MASS)?;
+    finite_positive(b.plate_mass, &at("plate_mass"), ranges::MASS)?;
+    let inertia = ranges::INERTIA;
+    all_positive(
+        &b.plate_inertia,
+        &at("plate_inertia"),
+        "an inertia",
+        inertia,
+    )?;
+    let viscous = ranges::VISCOUS_FRICTION;
+    all_non_negative(&b.viscous_friction, &at("viscous_friction"), viscous)?;
+    let stiction = ranges::STATIC_FRICTION;
+    all_non_negative(&b.static_friction, &at("static_friction"), stiction)?;
     if let Some(limit) = &b.effort_limit {
-        all_positive(limit, &["bench", "effort_limit"], "an effort limit")?;
+        all_positive(
+            limit,
+            &at("effort_limit"),
+            "an effort limit",
+            ranges::EFFORT,
+        )?;
     }
-    all_finite(&b.initial, &["bench", "initial"])?;
-    if !(b.gravity.is_finite() && b.gravity >= 0.0) {
-        return Err(Violation::at(
-            &["bench", "gravity"],
-            "must be finite and ≥ 0",
-        ));
-    }
-    Ok(())
+    all_finite(&b.initial, &at("initial"), ranges::JOINT_VALUE)?;
+    non_negative(b.gravity, &at("gravity"), ranges::GRAVITY)
 }
 
 fn check_control(c: &ControlSpec) -> Check {
     for (i, &o) in c.overshoot.iter().enumerate() {
         if !(o.is_finite() && o > 0.0 && o < 1.0) {
-            return Err(Violation::at(&["control", "overshoot"], "must be in (0, 1)").index(i));
+            return Err(Violation::at(
+                &["control", "overshoot"],
+                format!("must be in (0, 1), not {o}"),
+            )
+            .index(i));
         }
     }
     all_positive(
         &c.settling_time,
         &["control", "settling_time"],
         "a settling time",
+        ranges::SETTLING_TIME,
     )?;
     if !(c.pole_ratio.is_finite() && c.pole_ratio >= 1.0) {
         return Err(Violation::at(
             &["control", "pole_ratio"],
-            "must be finite and ≥ 1",
+            format!("must be finite and ≥ 1, not {}", c.pole_ratio),
         ));
     }
+    ranges::POLE_RATIO.check(c.pole_ratio, &["control", "pole_ratio"])?;
     if !(c.retune_margin.is_finite() && c.retune_margin > 0.0 && c.retune_margin <= 1.0) {
         return Err(Violation::at(
             &["control", "retune_margin"],
-            "must be in (0, 1]",
+            format!("must be in (0, 1], not {}", c.retune_margin),
         ));
     }
     if let Some(gains) = &c.gains {
         for (i, g) in gains.iter().enumerate() {
-            all_finite(g, &["control", "gains"]).map_err(|v| v.index(i))?;
+            all_finite(g, &["control", "gains"], ranges::GAIN).map_err(|v| v.index(i))?;
         }
     }
     finite_positive(
         c.external_acceleration,
         &["control", "external_acceleration"],
+        ranges::EXTERNAL_ACCELERATION,
     )?;
-    finite_positive(c.oscillation_rate, &["control", "oscillation_rate"])?;
+    finite_positive(
+        c.oscillation_rate,
+        &["control", "oscillation_rate"],
+        ranges::OSCILLATION_RATE,
+    )?;
     Ok(())
 }
 
@@ -199,22 +229,36 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
         finite_positive(
             s.natural_frequency,
             &[at[0], at[1], at[2], "natural_frequency"],
+            ranges::SMOOTHING_FREQUENCY,
         )?;
-        finite_positive(s.damping, &[at[0], at[1], at[2], "damping"])?;
+        finite_positive(
+            s.damping,
+            &[at[0], at[1], at[2], "damping"],
+            ranges::DAMPING,
+        )?;
     }
     let key = |k: &'static str| [at[0], at[1], k];
     match source {
-        SourceSpec::Constant { value } => finite(*value, &key("value")),
+        SourceSpec::Constant { value } => finite(*value, &key("value"), ranges::JOINT_VALUE),
         SourceSpec::Steps { points, .. } => {
             non_empty(points, &key("points"))?;
             let mut last = f64::NEG_INFINITY;
             for (i, &[t, v]) in points.iter().enumerate() {
                 let entry = |k, why| Violation::at(&key("points"), why).index(i).index(k);
                 if !(t.is_finite() && t >= 0.0 && t > last) {
-                    return Err(entry(0, "times must be finite, ≥ 0 and increasing"));
+                    return Err(entry(
+                        0,
+                        format!("times must be finite, ≥ 0 and increasing, not {t}"),
+                    ));
+                }
+                if !ranges::TIME.contains(t) {
+                    return Err(entry(0, ranges::TIME.refusal(t)));
                 }
                 if !v.is_finite() {
-                    return Err(entry(1, "must be finite"));
+                    return Err(entry(1, format!("must be finite, not {v}")));
+                }
+                if !ranges::JOINT_VALUE.contains(v) {
+                    return Err(entry(1, ranges::JOINT_VALUE.refusal(v)));
                 }
                 last = t;
             }
@@ -225,10 +269,16 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
             for (i, &[v, hold]) in points.iter().enumerate() {
                 let entry = |k, why| Violation::at(&key("points"), why).index(i).index(k);
                 if !v.is_finite() {
-                    return Err(entry(0, "must be finite"));
+                    return Err(entry(0, format!("must be finite, not {v}")));
+                }
+                if !ranges::JOINT_VALUE.contains(v) {
+                    return Err(entry(0, ranges::JOINT_VALUE.refusal(v)));
                 }
                 if !(hold.is_finite() && hold > 0.0) {
-                    return Err(entry(1, "hold must be finite and > 0"));
+                    return Err(entry(1, format!("hold must be finite and > 0, not {hold}")));
+                }
+                if !ranges::TIME.contains(hold) {
+                    return Err(entry(1, ranges::TIME.refusal(hold)));
                 }
             }
             Ok(())
@@ -239,18 +289,18 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
             phase,
             offset,
         } => {
-            finite(*amplitude, &key("amplitude"))?;
-            non_negative(*frequency, &key("frequency"))?;
-            finite(*phase, &key("phase"))?;
-            finite(*offset, &key("offset"))
+            finite(*amplitude, &key("amplitude"), ranges::JOINT_VALUE)?;
+            non_negative(*frequency, &key("frequency"), ranges::FREQUENCY)?;
+            finite(*phase, &key("phase"), ranges::JOINT_VALUE)?;
+            finite(*offset, &key("offset"), ranges::JOINT_VALUE)
         }
         SourceSpec::Polynomial { coefficients } => {
             non_empty(coefficients, &key("coefficients"))?;
-            all_finite(coefficients, &key("coefficients"))
+            all_finite(coefficients, &key("coefficients"), ranges::COEFFICIENT)
         }
         SourceSpec::RandomSetpoints { range, hold, .. } => {
-            interval(range, &key("range"), false)?;
-            interval(hold, &key("hold"), true)
+            interval(range, &key("range"), false, ranges::JOINT_VALUE)?;
+            interval(hold, &key("hold"), true, ranges::TIME)
         }
         SourceSpec::RandomSine {
             amplitude,
@@ -258,10 +308,10 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
             segment,
             offset,
         } => {
-            interval(amplitude, &key("amplitude"), false)?;
-            interval(frequency, &key("frequency"), true)?;
-            interval(segment, &key("segment"), true)?;
-            finite(*offset, &key("offset"))
+            interval(amplitude, &key("amplitude"), false, ranges::JOINT_VALUE)?;
+            interval(frequency, &key("frequency"), true, ranges::FREQUENCY)?;
+            interval(segment, &key("segment"), true, ranges::TIME)?;
+            finite(*offset, &key("offset"), ranges::JOINT_VALUE)
         }
         SourceSpec::Csv { column, .. } => {
             if column.is_empty() {
@@ -272,28 +322,29 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
     }
 }
 
-fn positive_nanos(s: f64, at: &[&str]) -> Result<Nanos, Violation> {
-    finite_positive(s, at)?;
+fn positive_nanos(s: f64, at: &[&str], range: Plausible) -> Result<Nanos, Violation> {
+    finite_positive(s, at, range)?;
     match nanos_from_seconds(s) {
         Some(ns) if ns > 0 => Ok(ns),
         _ => Err(Violation::at(
             at,
-            "must be at least 1 ns and at most 584 years",
+            format!("must be at least 1 ns, not {s} s"),
         )),
     }
 }
 
-fn finite(x: f64, at: &[&str]) -> Check {
+/// `x` finite and in `range`.
+pub(crate) fn finite(x: f64, at: &[&str], range: Plausible) -> Check {
     if x.is_finite() {
-        Ok(())
+        range.check(x, at)
     } else {
         Err(Violation::at(at, format!("must be finite, not {x}")))
     }
 }
 
-fn finite_positive(x: f64, at: &[&str]) -> Check {
+fn finite_positive(x: f64, at: &[&str], range: Plausible) -> Check {
     if x.is_finite() && x > 0.0 {
-        Ok(())
+        range.check(x, at)
     } else {
         Err(Violation::at(
             at,
@@ -302,9 +353,9 @@ fn finite_positive(x: f64, at: &[&str]) -> Check {
     }
 }
 
-fn non_negative(x: f64, at: &[&str]) -> Check {
+pub(crate) fn non_negative(x: f64, at: &[&str], range: Plausible) -> Check {
     if x.is_finite() && x >= 0.0 {
-        Ok(())
+        range.check(x, at)
     } else {
         Err(Violation::at(
             at,
@@ -313,27 +364,28 @@ fn non_negative(x: f64, at: &[&str]) -> Check {
     }
 }
 
-fn all_finite(xs: &[f64], at: &[&str]) -> Check {
+pub(crate) fn all_finite(xs: &[f64], at: &[&str], range: Plausible) -> Check {
     for (i, x) in xs.iter().enumerate() {
-        finite(*x, at).map_err(|v| v.index(i))?;
+        finite(*x, at, range).map_err(|v| v.index(i))?;
     }
     Ok(())
 }
 
-fn all_positive(xs: &[f64], at: &[&str], what: &str) -> Check {
+fn all_positive(xs: &[f64], at: &[&str], what: &str, range: Plausible) -> Check {
     for (i, &x) in xs.iter().enumerate() {
         if !(x.is_finite() && x > 0.0) {
             return Err(
                 Violation::at(at, format!("{what} must be finite and > 0, not {x}")).index(i),
             );
         }
+        range.check(x, at).map_err(|v| v.index(i))?;
     }
     Ok(())
 }
 
-fn all_non_negative(xs: &[f64], at: &[&str]) -> Check {
+pub(crate) fn all_non_negative(xs: &[f64], at: &[&str], range: Plausible) -> Check {
     for (i, x) in xs.iter().enumerate() {
-        non_negative(*x, at).map_err(|v| v.index(i))?;
+        non_negative(*x, at, range).map_err(|v| v.index(i))?;
     }
     Ok(())
 }
@@ -346,9 +398,9 @@ fn non_empty<T>(xs: &[T], at: &[&str]) -> Check {
     }
 }
 
-/// `[lo, hi]` finite with `lo ≤ hi`; `positive` also asks `lo > 0`.
-fn interval(r: &[f64; 2], at: &[&str], positive: bool) -> Check {
-    all_finite(r, at)?;
+/// `[lo, hi]` finite, in `range`, with `lo ≤ hi`; `positive` also asks `lo > 0`.
+fn interval(r: &[f64; 2], at: &[&str], positive: bool, range: Plausible) -> Check {
+    all_finite(r, at, range)?;
     if r[0] > r[1] {
         return Err(Violation::at(
             at,
@@ -356,7 +408,7 @@ fn interval(r: &[f64; 2], at: &[&str], positive: bool) -> Check {
         ));
     }
     if positive && r[0] <= 0.0 {
-        return Err(Violation::at(at, "must be > 0").index(0));
+        return Err(Violation::at(at, format!("must be > 0, not {}", r[0])).index(0));
     }
     Ok(())
 }

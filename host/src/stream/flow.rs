@@ -132,8 +132,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             .and_then(|()| self.stream())
             .and_then(|()| self.finish());
         if matches!(result, Err(StreamError::Interrupted)) {
-            // Best effort: the device holds its last sample instead of counting underruns.
-            let _ = self.send(&Message::Stop);
+            self.stop_after_interrupt();
         }
         result
     }

@@ -15,9 +15,13 @@
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before`: each write of the device under test (`bus` spi, i2c or aux; `dropped_before`: writes the device lost just before this batch) |
-//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`) |
+//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
+//!
+//! `meta.toml` ends with the `[completion]` table (status, samples written, why the session
+//! ended; [`crate::rundir`]), written once every file is closed: after the session, or after
+//! the device under test's reader when one is attached.
 
-use crate::output::TruthWriter;
+use crate::output::{TruthWriter, TRUTH_FILE};
 use crate::truth::Truth;
 use margemu_model::sensor;
 use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
@@ -26,6 +30,30 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use super::images::image_hex;
+
+/// `sent.csv`.
+pub const SENT_FILE: &str = "sent.csv";
+/// `served.csv`.
+pub const SERVED_FILE: &str = "served.csv";
+/// `device.csv`.
+pub const DEVICE_FILE: &str = "device.csv";
+/// `telemetry.csv`.
+pub const TELEMETRY_FILE: &str = "telemetry.csv";
+/// `register_writes.csv`.
+pub const REGISTER_WRITES_FILE: &str = "register_writes.csv";
+/// `events.csv`.
+pub const EVENTS_FILE: &str = "events.csv";
+
+/// The files of a session besides `meta.toml`.
+pub const SESSION_FILES: [&str; 7] = [
+    TRUTH_FILE,
+    SENT_FILE,
+    SERVED_FILE,
+    DEVICE_FILE,
+    TELEMETRY_FILE,
+    REGISTER_WRITES_FILE,
+    EVENTS_FILE,
+];
 
 /// Header of `sent.csv` in source mode images.
 pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image,resend";
@@ -68,16 +96,16 @@ impl SessionLog {
     /// source mode's), and writes `meta.toml`.
     pub fn create(dir: &Path, meta: &str, sent_columns: &str) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
-        std::fs::write(dir.join("meta.toml"), meta)?;
+        crate::rundir::write_meta(dir, meta)?;
         let mut log = Self {
             dir: dir.to_path_buf(),
             float: ryu::Buffer::new(),
-            sent: create(dir, "sent.csv", sent_columns)?,
-            served: create(dir, "served.csv", SERVED_COLUMNS)?,
-            device: create(dir, "device.csv", DEVICE_COLUMNS)?,
-            telemetry: create(dir, "telemetry.csv", TELEMETRY_COLUMNS)?,
-            register_writes: create(dir, "register_writes.csv", REGISTER_WRITES_COLUMNS)?,
-            events: create(dir, "events.csv", EVENTS_COLUMNS)?,
+            sent: create(dir, SENT_FILE, sent_columns)?,
+            served: create(dir, SERVED_FILE, SERVED_COLUMNS)?,
+            device: create(dir, DEVICE_FILE, DEVICE_COLUMNS)?,
+            telemetry: create(dir, TELEMETRY_FILE, TELEMETRY_COLUMNS)?,
+            register_writes: create(dir, REGISTER_WRITES_FILE, REGISTER_WRITES_COLUMNS)?,
+            events: create(dir, EVENTS_FILE, EVENTS_COLUMNS)?,
         };
         log.flush()?;
         Ok(log)
@@ -92,13 +120,13 @@ impl SessionLog {
     pub fn append_meta(&mut self, text: &str) -> io::Result<()> {
         let mut meta = std::fs::OpenOptions::new()
             .append(true)
-            .open(self.dir.join("meta.toml"))?;
+            .open(self.dir.join(crate::rundir::META_FILE))?;
         meta.write_all(text.as_bytes())
     }
 
     /// Writes `truth.csv` in one go.
     pub fn write_truth<'a>(&self, truths: impl Iterator<Item = &'a Truth>) -> io::Result<()> {
-        let file = BufWriter::with_capacity(1 << 20, File::create(self.dir.join("truth.csv"))?);
+        let file = BufWriter::with_capacity(1 << 20, File::create(self.dir.join(TRUTH_FILE))?);
         let mut out = TruthWriter::new(file)?;
         for t in truths {
             out.write(t)?;

@@ -6,8 +6,12 @@
 //! file whenever its queue runs empty, so rows reach the operating system within moments of
 //! being queued, and an interrupted session loses nothing that was queued: [`Logger::finish`]
 //! (also run on drop) writes the rest, flushes and reports the first error.
+//!
+//! The logger also holds the session's share of the directory's completion record
+//! ([`CompletionRecord`]): [`Logger::end`] sets it and lets go of it after the last row.
 
 use super::log::SessionLog;
+use crate::rundir::{Completion, CompletionRecord};
 use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{channel, Sender};
@@ -21,12 +25,14 @@ pub(super) struct Logger {
     dir: PathBuf,
     tx: Option<Sender<Job>>,
     thread: Option<JoinHandle<io::Result<()>>>,
+    completion: Option<CompletionRecord>,
 }
 
 impl Logger {
     /// Moves `log` to a new writer thread.
     pub(super) fn spawn(mut log: SessionLog) -> io::Result<Self> {
         let dir = log.dir().to_path_buf();
+        let completion = Some(CompletionRecord::new(&dir));
         let (tx, rx) = channel::<Job>();
         let thread = std::thread::Builder::new()
             .name("margemu-log".into())
@@ -44,7 +50,28 @@ impl Logger {
             dir,
             tx: Some(tx),
             thread: Some(thread),
+            completion,
         })
+    }
+
+    /// A share of the directory's completion record, for another writer of the directory (the
+    /// record is written when the last share is let go).
+    pub(super) fn completion(&self) -> Option<CompletionRecord> {
+        self.completion.clone()
+    }
+
+    /// Ends the writer (as [`Logger::finish`]), then records `completion` (failed instead if the
+    /// logs could not be written) and lets go of the logger's share of the record.
+    pub(super) fn end(&mut self, mut completion: Completion) -> io::Result<()> {
+        let finished = self.finish();
+        if let Err(e) = &finished {
+            completion.fail(format!("cannot write the logs: {e}"));
+        }
+        let Some(record) = self.completion.take() else {
+            return finished;
+        };
+        record.update(|c| *c = completion);
+        finished.and(record.release())
     }
 
     /// The session directory.

@@ -33,6 +33,7 @@
 //! ([`log`], written by their own thread) are flushed and end with an `end` row in
 //! `events.csv`.
 
+mod ending;
 mod flow;
 pub mod images;
 pub mod log;

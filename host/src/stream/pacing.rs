@@ -219,15 +219,6 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             self.pump(deadline)?;
         }
         self.report(true);
-        match self.telemetry {
-            Some(t) if t.state == DeviceState::Stopped => {
-                let detail = format!(
-                    "served {} samples, last index {}, underruns {}",
-                    t.samples_served, t.last_served_index, t.underruns
-                );
-                self.event("stopped", &detail)
-            }
-            _ => self.event("stop_unconfirmed", "no Telemetry in the stopped state"),
-        }
+        self.log_stop_outcome()
     }
 }

@@ -10,6 +10,7 @@ use super::model::predict_model;
 use super::rx;
 use super::source::Items;
 use super::{Progress, StreamError, Summary};
+use crate::rundir::{Completion, CompletionRecord, Status};
 use crate::scene::chip::ChipSetup;
 use crate::scene::Scene;
 use margemu_protocol::link::Rate;
@@ -163,6 +164,13 @@ impl Session {
         self.origin = Some(origin);
     }
 
+    /// A share of the session directory's completion record ([`crate::rundir`]), for a writer
+    /// that logs into the directory beside the session (the device under test's reader): the
+    /// record is written to `meta.toml` when the session has ended and every share is let go.
+    pub fn completion_record(&self) -> Option<CompletionRecord> {
+        self.log.completion()
+    }
+
     /// The predicted output samples, in order (truth and the image the device should serve).
     pub fn samples(&self) -> &[PredictedSample] {
         &self.samples
@@ -187,8 +195,10 @@ impl Session {
 
     /// Runs the session: `reader` and `writer` are the two directions of the port (`reader` must
     /// return from `read` now and then, by data, timeout or end of file). `progress` is called
-    /// about ten times a second. Whatever the outcome, the logs are flushed and `events.csv` ends
-    /// with an `end` row saying how the session ended.
+    /// about ten times a second. Whatever the outcome, the logs are flushed, `events.csv` ends
+    /// with an `end` row saying how the session ended, and `meta.toml` gets its completion
+    /// record (complete, interrupted or failed; [`crate::rundir`]) once every other writer of
+    /// the directory has let go of its share ([`Session::completion_record`]).
     pub fn run(
         mut self,
         reader: impl Read + Send + 'static,
@@ -203,14 +213,26 @@ impl Session {
         let summary = run.summary();
         drop(run);
         shutdown.store(true, Ordering::Relaxed);
-        let (event, detail) = match &result {
-            Ok(()) => ("end", "completed".to_string()),
-            Err(e) => ("end", format!("error: {e}")),
+        let (status, ended) = match &result {
+            Ok(()) => (Status::Complete, "completed".to_string()),
+            Err(e @ StreamError::Interrupted) => (Status::Interrupted, e.to_string()),
+            Err(e) => (Status::Failed, e.to_string()),
+        };
+        let detail = match status {
+            Status::Complete => ended.clone(),
+            _ => format!("error: {ended}"),
+        };
+        let served = &summary.served;
+        let completion = Completion {
+            status,
+            samples_written: served.samples - served.unreported,
+            samples_expected: Some(served.samples),
+            ended,
         };
         let logged = self
             .log
-            .write(move |log| log.event(end_ns, event, &detail))
-            .and_then(|()| self.log.finish());
+            .write(move |log| log.event(end_ns, "end", &detail))
+            .and_then(|()| self.log.end(completion));
         result?;
         logged.map_err(|source| StreamError::Log {
             path: self.log.dir().to_path_buf(),

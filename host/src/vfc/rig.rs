@@ -6,7 +6,9 @@
 //! - [`attach`]: a device-under-test reader ([`crate::dut`]) on any port, on the session's own
 //!   clock (its origin is set on the session) and in its directory; [`AttachedDut::finish`],
 //!   once the session has run, stops it and records its summary: a `dut` row appended to
-//!   `events.csv` (after the session's `end` row) and a `[dut]` table to `meta.toml`. This is
+//!   `events.csv` (after the session's `end` row) and a `[dut]` table to `meta.toml`, then
+//!   lets go of its share of the completion record ([`crate::rundir`]), so the record follows
+//!   the `[dut]` table (a reader that fails marks the run failed). This is
 //!   what `margemu stream --dut` and `margemu loopback --dut` do;
 //! - [`run_loopback`]: one whole loopback run with a flight controller, in process.
 
@@ -15,6 +17,7 @@ use super::uart::{self, UartReport, UartThread};
 use super::VfcConfig;
 use crate::dut::{DutConfig, DutError, DutProgress, DutProtocol, DutReader, DutSummary};
 use crate::loopback::{spawn_device_with_local, DeviceReport, LoopbackDevice};
+use crate::rundir::CompletionRecord;
 use crate::scene::Scene;
 use crate::stream::{Progress, Session, StreamConfig, StreamError, Summary};
 use margemu_protocol::chip::ChipSettings;
@@ -141,6 +144,7 @@ pub struct AttachedDut {
     reader: DutReader,
     origin: Instant,
     dir: PathBuf,
+    completion: Option<CompletionRecord>,
 }
 
 /// Starts a reader of `config` on `port`, logging into `dir` (the session's directory, which
@@ -158,6 +162,7 @@ pub fn attach(
         reader,
         origin,
         dir: dir.to_path_buf(),
+        completion: session.completion_record(),
     })
 }
 
@@ -185,7 +190,16 @@ impl AttachedDut {
     /// Stops the reader and records its summary in the session directory (call it after the
     /// session has run: the session's own logs are closed then).
     pub fn finish(self) -> Result<DutSummary, DutError> {
-        let summary = self.reader.stop()?;
+        let completion = self.completion;
+        let fail = |why: String| {
+            if let Some(record) = &completion {
+                record.update(|c| c.fail(why));
+            }
+        };
+        let summary = self
+            .reader
+            .stop()
+            .inspect_err(|e| fail(format!("device under test: {e}")))?;
         let host_ns = self.origin.elapsed().as_nanos() as i64;
         let detail = summary.to_string().replace([',', '\n'], ";");
         let log_err = |source| DutError::Log {
@@ -193,11 +207,24 @@ impl AttachedDut {
             source,
         };
         append(
-            &self.dir.join("events.csv"),
+            &self.dir.join(crate::stream::log::EVENTS_FILE),
             &format!("{host_ns},dut,{detail}\n"),
         )
+        .and_then(|()| {
+            append(
+                &self.dir.join(crate::rundir::META_FILE),
+                &summary.meta_toml(),
+            )
+        })
+        .inspect_err(|e| {
+            fail(format!(
+                "cannot record the device under test's summary: {e}"
+            ))
+        })
         .map_err(log_err)?;
-        append(&self.dir.join("meta.toml"), &summary.meta_toml()).map_err(log_err)?;
+        completion
+            .map_or(Ok(()), CompletionRecord::release)
+            .map_err(log_err)?;
         Ok(summary)
     }
 }

@@ -124,3 +124,68 @@ pub fn served(dir: &Path, total: u64) -> Vec<(u64, bool, bool)> {
         .filter(|&(k, _, _)| k < total)
         .collect()
 }
+
+/// Starts the `margemu` binary with `args` in `cwd`, its output captured.
+pub fn spawn_margemu(args: &[&OsStr], cwd: &Path) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_margemu"))
+        .args(args)
+        .current_dir(cwd)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Polls until `ready()` holds (every 10 ms); panics, naming `what`, if `child` exits first or
+/// a minute passes (a guard against hanging, not a timing assertion).
+pub fn wait_until(child: &mut std::process::Child, what: &str, ready: impl Fn() -> bool) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while !ready() {
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("margemu exited ({status}) before {what}");
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "no {what} within a minute"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
+/// Whether `dir/events.csv` has a row of `event`.
+pub fn has_event(dir: &Path, event: &str) -> bool {
+    std::fs::read_to_string(dir.join("events.csv"))
+        .map(|text| text.lines().any(|l| l.split(',').nth(1) == Some(event)))
+        .unwrap_or(false)
+}
+
+/// Sends `signal` (a name `kill` knows: TERM, HUP, INT, KILL) to `child`.
+pub fn send_signal(child: &std::process::Child, signal: &str) {
+    let status = Command::new("kill")
+        .arg(format!("-{signal}"))
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(status.success(), "kill -{signal}");
+}
+
+/// A scene file in `dir`: the Figure 3 bench scene lasting `seconds`, so that a run is still
+/// going when a test stops it.
+pub fn long_scene(dir: &Path, seconds: f64) -> PathBuf {
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("../hil-fixtures/scenes/figure3.toml");
+    let text = std::fs::read_to_string(fixture).unwrap();
+    assert!(text.contains("duration = 3.0\n"));
+    let path = dir.join("long.toml");
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(
+        &path,
+        text.replace("duration = 3.0\n", &format!("duration = {seconds}\n")),
+    )
+    .unwrap();
+    path
+}
+
+/// The `[completion]` table of `dir/meta.toml`.
+pub fn completion(dir: &Path) -> Option<margemu::rundir::Completion> {
+    margemu::rundir::read_completion(dir).unwrap()
+}
