@@ -10,6 +10,7 @@ pub(crate) struct Table {
     path: PathBuf,
     reader: csv::Reader<File>,
     header: csv::StringRecord,
+    record: csv::StringRecord,
 }
 
 impl Table {
@@ -28,6 +29,7 @@ impl Table {
             path: path.to_path_buf(),
             reader,
             header,
+            record: csv::StringRecord::new(),
         })
     }
 
@@ -55,33 +57,39 @@ impl Table {
         Ok(out)
     }
 
+    /// The next data row, or `None` at the end of the file: a cursor for readers that stream
+    /// (one row in memory at a time).
+    pub fn next_row(&mut self) -> Result<Option<Row<'_>>, ColumnError> {
+        let more =
+            self.reader
+                .read_record(&mut self.record)
+                .map_err(|cause| ColumnError::Read {
+                    path: self.path.clone(),
+                    cause,
+                })?;
+        if !more {
+            return Ok(None);
+        }
+        let line = self.record.position().map_or(0, |p| p.line());
+        Ok(Some(Row {
+            path: &self.path,
+            header: &self.header,
+            record: &self.record,
+            line,
+        }))
+    }
+
     /// Calls `f` on every data row, in order; stops at the first error. Returns the row count.
     pub fn for_each(
         mut self,
         mut f: impl FnMut(&Row<'_>) -> Result<(), ColumnError>,
     ) -> Result<usize, ColumnError> {
-        let mut record = csv::StringRecord::new();
         let mut rows = 0;
-        loop {
-            let more = self
-                .reader
-                .read_record(&mut record)
-                .map_err(|cause| ColumnError::Read {
-                    path: self.path.clone(),
-                    cause,
-                })?;
-            if !more {
-                return Ok(rows);
-            }
-            let line = record.position().map_or(0, |p| p.line());
-            f(&Row {
-                path: &self.path,
-                header: &self.header,
-                record: &record,
-                line,
-            })?;
+        while let Some(row) = self.next_row()? {
+            f(&row)?;
             rows += 1;
         }
+        Ok(rows)
     }
 }
 
@@ -113,7 +121,8 @@ impl Row<'_> {
         self.record.get(i).unwrap_or("")
     }
 
-    fn name(&self, i: usize) -> &str {
+    /// The name of column `i`.
+    pub fn name(&self, i: usize) -> &str {
         self.header.get(i).unwrap_or("?")
     }
 
@@ -121,6 +130,13 @@ impl Row<'_> {
     pub fn f64(&self, i: usize) -> Result<f64, ColumnError> {
         self.opt_f64(i)?
             .ok_or_else(|| self.error(format!("`{}` is empty", self.name(i))))
+    }
+
+    /// Column `i` as a number, `NaN` and infinities included (for values a reader checks itself).
+    pub fn any_f64(&self, i: usize) -> Result<f64, ColumnError> {
+        let text = self.text(i);
+        text.parse::<f64>()
+            .map_err(|_| self.error(format!("`{}` = {text:?} is not a number", self.name(i))))
     }
 
     /// Column `i` as a finite number, or `None` when empty.

@@ -62,14 +62,15 @@ fn dut_attitude_errors_name_file_line_and_cause() {
         "dut_attitude.csv:3",
         "`host_ns` = 1500 does not increase (previous row: 2000)",
     );
+    // A device's zero quaternion is skipped and counted, not refused: see evaluate_session.rs.
     let err = session_error(
         "zero",
-        &format!("{DUT_HEADER}{good}3000,serial,att,,0,0,0,0,0,0,0\n"),
+        &format!("{DUT_HEADER}3000,serial,att,,0,0,0,0,0,0,0\n"),
     );
     ends(
         &err,
-        "dut_attitude.csv:3",
-        "quaternion [0.0, 0.0, 0.0, 0.0] has no direction (zero norm)",
+        "dut_attitude.csv",
+        "no row with a usable quaternion (1 unusable)",
     );
     let err = session_error("short", &format!("{DUT_HEADER}{good}3000,serial,att\n"));
     assert!(
@@ -191,7 +192,8 @@ fn external_and_estimate_file_errors_are_located() {
     ends(
         &err,
         "est.csv:3",
-        "`t_s` = 10000000 does not increase (previous row: 10000000)",
+        // In seconds, as the column has them (not the nanoseconds they are compared in).
+        "`t_s` = 0.01 does not increase (previous row: 0.01)",
     );
     let err = external_error("est-cols", &text, Some("t,qw,qx,qy,qz\n"));
     ends(

@@ -141,3 +141,64 @@ fn the_command_line_refuses_bad_parameters_and_writes_nothing() {
     ok(&run(&["--filter", "ecf"]));
     assert!(out.exists());
 }
+
+#[test]
+fn a_bad_row_after_estimates_were_written_leaves_no_estimates_file() {
+    let dir = scratch("filter-errors-late");
+    let input = dir.join("rec.csv");
+    let good: String = (0..50)
+        .map(|k| format!("{},0,0,9.8,0,0,0,0.5,0,-0.83\n", f64::from(k) * 0.01))
+        .collect();
+    std::fs::write(
+        &input,
+        format!("{HEADER}{good}0.5,0,0,9.8,0,0,0,0.5,0,nan\n"),
+    )
+    .unwrap();
+    let out = dir.join("est.csv");
+    let args = ["filter", "--filter", "ekf", input.to_str().unwrap(), "-o"];
+    let e = failed(&margemu(&[&args[..], &[out.to_str().unwrap()]].concat()));
+    assert!(e.contains("rec.csv:52: `mz` = NaN is not finite"), "{e}");
+    assert!(!out.exists(), "a partial estimates file was left");
+}
+
+#[test]
+fn all_zero_accelerometer_or_magnetometer_data_is_warned_about() {
+    let dir = scratch("filter-warnings");
+    let run = |name: &str, acc: &str, mag: &str| {
+        let input = dir.join(format!("{name}.csv"));
+        let rows: String = (0..20)
+            .map(|k| format!("{},{acc},0.01,0,0,{mag}\n", f64::from(k) * 0.01))
+            .collect();
+        std::fs::write(&input, format!("{HEADER}{rows}")).unwrap();
+        let out = dir.join(format!("{name}-est.csv"));
+        let args = ["filter", "--filter", "ecf", input.to_str().unwrap(), "-o"];
+        let output = margemu(&[&args[..], &[out.to_str().unwrap()]].concat());
+        ok(&output);
+        assert!(out.exists());
+        String::from_utf8_lossy(&output.stderr).into_owned()
+    };
+    let acc_warning = "every accelerometer sample is zero";
+    let mag_warning = "every magnetometer sample is zero";
+    let both = run("both", "0,0,0", "0,0,0");
+    assert!(
+        both.contains(acc_warning) && both.contains(mag_warning),
+        "{both}"
+    );
+    assert!(
+        both.contains("warning: ") && both.contains("both.csv"),
+        "{both}"
+    );
+    let mag = run("mag", "0,0,9.8", "0,0,0");
+    assert!(
+        !mag.contains(acc_warning) && mag.contains(mag_warning),
+        "{mag}"
+    );
+    let acc = run("acc", "0,0,0", "0.5,0,-0.83");
+    assert!(
+        acc.contains(acc_warning) && !acc.contains(mag_warning),
+        "{acc}"
+    );
+    // One zero sample among good ones is no warning.
+    let fine = run("fine", "0,0,9.8", "0.5,0,-0.83");
+    assert!(!fine.contains("warning"), "{fine}");
+}

@@ -187,3 +187,65 @@ fn bad_sensor_sections_are_located() {
         assert!(err.contains(reason), "reason of {section:?}: {err}");
     }
 }
+
+#[test]
+fn analyze_noise_takes_t_s_as_the_time_column_like_filter() {
+    let work = std::env::temp_dir().join(format!("margemu-analyze-t-s-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&work);
+    std::fs::create_dir_all(&work).unwrap();
+    let scene_path = work.join("noise.toml");
+    let dir = work.join("run");
+    std::fs::write(
+        &scene_path,
+        "duration = 20.0\nrate = 200.0\nseed = 5\nmotion = \"static\"\n[sensors.gyro]\nnoise_density = [0.01, 0.01, 0.01]\n",
+    )
+    .unwrap();
+    let bin = env!("CARGO_BIN_EXE_margemu");
+    let run = Command::new(bin)
+        .args(["simulate", scene_path.to_str().unwrap(), "-o"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    // The same samples as an external recording: `t_s` in seconds, `filter`'s column names.
+    let marg = std::fs::read_to_string(dir.join("marg.csv")).unwrap();
+    let mut lines = marg.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (t, gy) = (col("t_ns"), col("gyr_y"));
+    let mut recording = String::from("t_s,gy\n");
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let ns: u64 = f[t].parse().unwrap();
+        recording += &format!(
+            "{}.{:09},{}\n",
+            ns / 1_000_000_000,
+            ns % 1_000_000_000,
+            f[gy]
+        );
+    }
+    std::fs::write(dir.join("rec.csv"), recording).unwrap();
+    let analyze = |file: &str, column: &str| {
+        let out = Command::new(bin)
+            .args(["analyze", "noise"])
+            .arg(dir.join(file))
+            .args(["--column", column])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        // Everything after the line naming the file and column.
+        text.lines().skip(1).collect::<Vec<_>>().join("\n")
+    };
+    let from_ns = analyze("marg.csv", "gyr_y");
+    assert!(from_ns.contains("Allan deviation at τ = 1 s:"), "{from_ns}");
+    assert_eq!(analyze("rec.csv", "gy"), from_ns);
+}

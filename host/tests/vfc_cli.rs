@@ -305,3 +305,36 @@ fn stream_logs_a_device_under_test_on_dut() {
     assert_dut_logged(&session, 60, &all);
     board.join().unwrap();
 }
+
+#[test]
+fn evaluate_scores_one_message_stream_of_a_loopback_session_by_default() {
+    // The flight controller sends ATTITUDE and ATTITUDE_QUATERNION of each sample with one
+    // device time stamp: scored together, the stamps would not increase and every second row
+    // would be dropped.
+    let dir = scratch("vfc-evaluate");
+    let session = dir.join("session");
+    let out = margemu(&[
+        "loopback",
+        path(&dir.join("scene.toml")),
+        "-o",
+        path(&session),
+        "--vfc",
+        "ekf",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let out = margemu(&["evaluate", path(&session), "--no-plots"]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    assert!(!all.contains("not used"), "{all}");
+    assert!(all.contains("rows stamped through the fit"), "{all}");
+    assert!(
+        all.contains("scored mavlink2/ATTITUDE_QUATERNION (choose another with --message)"),
+        "{all}"
+    );
+    assert!(
+        !all.contains("with the stamp of a later row dropped"),
+        "{all}"
+    );
+    let (_, errors) = csv(&session, "errors.csv");
+    assert_eq!(errors.len(), 100, "one scored row per sample");
+}

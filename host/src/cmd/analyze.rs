@@ -8,7 +8,8 @@ use std::path::PathBuf;
 pub enum Cmd {
     /// Overlapping Allan deviation (τ from 1/rate to N/10) and Welch PSD of one column.
     Noise {
-        /// A CSV with a `t_ns` column (truth.csv, marg.csv, …).
+        /// A CSV with a time column, `t_ns` (truth.csv, marg.csv, …) or `t_s` (an external
+        /// recording, an estimates file).
         file: PathBuf,
         /// The column to analyse.
         #[arg(long)]

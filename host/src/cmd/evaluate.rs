@@ -128,9 +128,10 @@ impl Cmd {
             },
             allow_incomplete: self.allow_incomplete,
         };
-        let eval = margemu::evaluate::evaluate(&source, &options)?;
-        print!("{}", report::summary(&eval));
         let out = self.out.unwrap_or(default_out);
+        let eval =
+            margemu::evaluate::evaluate_writing(&source, &options, Some(&out.join("errors.csv")))?;
+        print!("{}", report::summary(&eval));
         let written = report::write(&eval, &out, !self.no_plots)?;
         let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
         println!("wrote {}", names.join(", "));

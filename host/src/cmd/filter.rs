@@ -3,8 +3,6 @@
 
 use anyhow::{bail, Context, Result};
 use margemu::offline::{self, AttitudeStart, FilterKind, FilterParams, Initial};
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -56,28 +54,26 @@ impl Cmd {
             Some(&[x, y, z]) => Some([x, y, z]),
             Some(other) => bail!("--mag-reference needs three numbers, not {other:?}"),
         };
-        let recording = offline::read(&self.input, reference)?;
         let initial = match self.attitude_start {
             AttitudeStart::FirstSample => Initial::FirstSample,
             AttitudeStart::Truth => Initial::Attitude(offline::first_true_attitude(&self.input)?),
         };
         let start = Instant::now();
-        let estimates = offline::run(&params, &recording.imu, recording.mag_reference, initial)?;
+        let run = offline::filter_to_file(&params, &self.input, reference, initial, &self.output)?;
         let elapsed = start.elapsed();
-        let file = File::create(&self.output)
-            .with_context(|| format!("{}: cannot create", self.output.display()))?;
-        offline::write_estimates(&mut BufWriter::new(file), &estimates)
-            .with_context(|| format!("{}: cannot write", self.output.display()))?;
+        for warning in run.warnings() {
+            eprintln!("warning: {warning}");
+        }
         let values: Vec<String> = params
             .iter()
             .map(|(p, v)| format!("{}={v}", p.name))
             .collect();
         println!(
-            "{} ({}) over {} samples of {} in {:.3} s; wrote {}",
+            "{} ({}) over {} samples of {} in {:.3} s (reading and writing included); wrote {}",
             self.filter,
             values.join(", "),
-            estimates.len(),
-            recording.source,
+            run.samples,
+            run.source,
             elapsed.as_secs_f64(),
             self.output.display()
         );

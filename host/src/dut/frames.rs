@@ -42,8 +42,15 @@ impl Attitude {
     }
 
     /// From a quaternion `(w, x, y, z)`, normalized here; the Euler angles are computed from it.
-    /// A quaternion that cannot be normalized (zero, not finite) gives non-finite numbers.
+    /// A quaternion that has no direction ([`normalize`](crate::evaluate::quat::normalize):
+    /// zero, near zero, not finite) gives NaN throughout, which evaluation skips and counts.
     pub fn from_quaternion(q: [f64; 4]) -> Self {
+        if crate::evaluate::quat::normalize(q).is_none() {
+            return Self {
+                euler: [f64::NAN; 3],
+                quaternion: [f64::NAN; 4],
+            };
+        }
         let [w, x, y, z] = q;
         let norm = libm::sqrt(w * w + x * x + y * y + z * z);
         let q = [w / norm, x / norm, y / norm, z / norm];
@@ -103,6 +110,23 @@ mod tests {
         let u = UnitQuaternion::new_unchecked(Quaternion::new(q[0], q[1], q[2], q[3]));
         let v = u * nalgebra::Vector3::from(body);
         [v.x, v.y, v.z]
+    }
+
+    #[test]
+    fn a_quaternion_without_direction_is_nan_not_a_rotation() {
+        for q in [
+            [1e-30, 1e-30, 0.0, 0.0],
+            [0.0; 4],
+            [f64::NAN, 0.0, 0.0, 1.0],
+        ] {
+            let a = Attitude::from_quaternion(q);
+            assert!(
+                a.quaternion.iter().chain(&a.euler).all(|v| v.is_nan()),
+                "{q:?}: {a:?}"
+            );
+        }
+        let a = Attitude::from_quaternion([0.0, 2.0, 0.0, 0.0]);
+        assert_eq!(a.quaternion, [0.0, 1.0, 0.0, 0.0]);
     }
 
     #[test]

@@ -8,7 +8,10 @@
 //! `[−max_lag, +max_lag]` in steps of the truth's sample period, on at most about 2000
 //! estimates (and only at lags where at least half as many overlap as at the best overlapping
 //! lag); a golden-section search over the two steps around the coarse minimum, on every
-//! estimate, refines it to 100 ns. `L` is the whole delay from the instant a sample
+//! estimate up to [`FINE_POINTS`] (evenly spaced ones beyond: the cost is a smooth mean, and
+//! those estimates with the truth around them fit in memory), refines it to 100 ns. Files are
+//! read once for the scan and once to gather the refinement's estimates, with only a window of
+//! the truth in memory. `L` is the whole delay from the instant a sample
 //! describes to the time stamp its estimate carries: transport, the filter's processing and its
 //! own phase lag alike. Motion is what makes `L` observable: when the lowest cost is not at least
 //! 20 % below the median cost of the scan (a plate at rest, say), the estimate is reported as
@@ -22,7 +25,11 @@
 //! device clock read 0, plus the link's shortest delay), its drift `(rate/1000 − 1)·10⁶` ppm,
 //! and the residual (how late the arrivals are against the line).
 
-use super::score::{Estimates, Reference, ScoreOptions};
+use super::quat::geodesic;
+use super::run::EvalError;
+use super::score::{after_warmup, locate, Estimates, Reference, Sample, ScoreOptions};
+use super::series::Series;
+use super::walk::Walk;
 
 /// Where and how finely the latency is searched.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,32 +82,104 @@ pub fn estimate_latency(
     estimates: &Estimates,
     search: &LatencySearch,
 ) -> Option<Latency> {
-    let step = search.step_ns.unwrap_or(reference.median_step_ns()).max(1) as i64;
-    let stride = estimates.len().div_ceil(COARSE_POINTS).max(1);
-    let max = search.max_lag_ns as i64;
-    let cost = |lag: i64, stride: usize| {
-        let opts = ScoreOptions {
-            latency_ns: lag,
-            ..search.score
-        };
-        reference.geodesic_cost(estimates, &opts, stride)
+    let truth = TruthFacts {
+        first_ns: reference.samples()[0].0,
+        median_step_ns: reference.median_step_ns(),
     };
+    let (truth_series, estimate_series) = (
+        Series::Memory(reference.samples().to_vec()),
+        Series::Memory(estimates.samples().to_vec()),
+    );
+    // In-memory series read without fault.
+    latency_of_series(
+        &truth_series,
+        &truth,
+        &estimate_series,
+        estimates.len(),
+        search,
+    )
+    .ok()
+    .flatten()
+}
+
+/// What alignment needs to know of the truth before reading it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct TruthFacts {
+    /// Its first instant (ns).
+    pub(super) first_ns: u64,
+    /// Its median sample spacing (ns).
+    pub(super) median_step_ns: u64,
+}
+
+impl TruthFacts {
+    /// The largest spacing interpolated across, by `opts` or by default.
+    pub(super) fn max_gap_ns(&self, opts: &ScoreOptions) -> u64 {
+        opts.max_gap_ns.unwrap_or(4 * self.median_step_ns)
+    }
+}
+
+/// [`estimate_latency`] over series read from their start for each pass (see the module docs):
+/// the coarse scan in one pass, the estimates of the refinement (every one up to
+/// [`FINE_POINTS`], evenly spaced beyond) with the truth around them in a second.
+pub(super) fn latency_of_series(
+    truth: &Series,
+    facts: &TruthFacts,
+    estimates: &Series,
+    count: usize,
+    search: &LatencySearch,
+) -> Result<Option<Latency>, EvalError> {
+    let step = search.step_ns.unwrap_or(facts.median_step_ns).max(1) as i64;
+    let max = search.max_lag_ns as i64;
     let n_steps = max / step;
-    let scan: Vec<(i64, f64, usize)> = (-n_steps..=n_steps)
-        .filter_map(|i| cost(i * step, stride).map(|(c, n)| (i * step, c, n)))
+    let lags: Vec<i64> = (-n_steps..=n_steps).map(|i| i * step).collect();
+    let max_gap = facts.max_gap_ns(&search.score);
+    let first = facts.first_ns;
+    let stride = count.div_ceil(COARSE_POINTS).max(1);
+    let mut sums = vec![(0.0f64, 0usize); lags.len()];
+    let mut walk = Walk::new(truth)?;
+    for (j, estimate) in estimates.read()?.enumerate() {
+        let (stamp, q) = estimate?;
+        if j % stride != 0 {
+            continue;
+        }
+        let t = stamp as i64;
+        let (window, base) = walk.cover(t - n_steps * step, t + n_steps * step, &mut |_, _| {})?;
+        for (sum, lag) in sums.iter_mut().zip(&lags) {
+            let aligned = t - lag;
+            if !after_warmup(aligned, first, &search.score) {
+                continue;
+            }
+            if let Some(truth) = locate(window, base, aligned, max_gap) {
+                let g = geodesic(&truth.q, &q);
+                sum.0 += g * g;
+                sum.1 += 1;
+            }
+        }
+    }
+    let scan: Vec<(i64, f64, usize)> = lags
+        .iter()
+        .zip(&sums)
+        .filter(|(_, s)| s.1 > 0)
+        .map(|(&lag, s)| (lag, s.0 / s.1 as f64, s.1))
         .collect();
-    let most = scan.iter().map(|s| s.2).max()?;
+    let Some(most) = scan.iter().map(|s| s.2).max() else {
+        return Ok(None);
+    };
     let curve: Vec<(i64, f64)> = scan
         .iter()
         .filter(|s| 2 * s.2 >= most)
         .map(|s| (s.0, s.1))
         .collect();
-    let (best_i, &(coarse, _)) = curve
+    let Some((best_i, &(coarse, _))) = curve
         .iter()
         .enumerate()
-        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))?;
+        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+    else {
+        return Ok(None);
+    };
     let at_edge = best_i == 0 || best_i + 1 == curve.len();
-    let full = |lag: i64| cost(lag, 1).map_or(f64::INFINITY, |c| c.0);
+    let fine = Refinement::gather(truth, estimates, count, (coarse - step, coarse + step))?;
+    let full = |lag: i64| fine.cost(lag, first, max_gap, &search.score);
     let refined = golden_min(
         |lag| full(lag.round() as i64),
         (coarse - step) as f64,
@@ -108,9 +187,12 @@ pub fn estimate_latency(
         100.0,
     )
     .round() as i64;
-    let (lag_ns, best) = [(refined, full(refined)), (coarse, full(coarse))]
+    let Some((lag_ns, best)) = [(refined, full(refined)), (coarse, full(coarse))]
         .into_iter()
-        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+    else {
+        return Ok(None);
+    };
     let mut costs: Vec<f64> = curve.iter().map(|c| c.1).collect();
     costs.sort_by(f64::total_cmp);
     let median = costs[costs.len() / 2];
@@ -119,14 +201,76 @@ pub fn estimate_latency(
     } else {
         0.0
     };
-    Some(Latency {
+    Ok(Some(Latency {
         lag_ns,
         cost: best,
         contrast,
         observable: contrast >= MIN_CONTRAST && !at_edge,
         at_edge,
         curve,
-    })
+    }))
+}
+
+/// Estimates the refinement uses: all of them up to this many, evenly spaced beyond (about
+/// 20 MB with the truth around them), so the refinement's many passes run in memory.
+pub const FINE_POINTS: usize = 100_000;
+
+/// The refinement's estimates, each with the truth samples its aligned instants can fall
+/// between over the refinement's lag range.
+struct Refinement {
+    truth: Vec<Sample>,
+    /// An estimate, where its truth starts in `truth`, how many, and the index in the truth of
+    /// the first.
+    estimates: Vec<(Sample, usize, usize, usize)>,
+}
+
+impl Refinement {
+    fn gather(
+        truth: &Series,
+        estimates: &Series,
+        count: usize,
+        (lo, hi): (i64, i64),
+    ) -> Result<Self, EvalError> {
+        let stride = count.div_ceil(FINE_POINTS).max(1);
+        let mut out = Self {
+            truth: Vec::new(),
+            estimates: Vec::new(),
+        };
+        let mut walk = Walk::new(truth)?;
+        for (j, estimate) in estimates.read()?.enumerate() {
+            let estimate = estimate?;
+            if j % stride != 0 {
+                continue;
+            }
+            let t = estimate.0 as i64;
+            let (window, base) = walk.cover(t - hi, t - lo, &mut |_, _| {})?;
+            out.estimates
+                .push((estimate, out.truth.len(), window.len(), base));
+            out.truth.extend_from_slice(window);
+        }
+        Ok(out)
+    }
+
+    /// Mean squared geodesic error at `lag` (infinite when no estimate is scored).
+    fn cost(&self, lag: i64, first: u64, max_gap: u64, opts: &ScoreOptions) -> f64 {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for &((stamp, q), start, len, base) in &self.estimates {
+            let aligned = stamp as i64 - lag;
+            if !after_warmup(aligned, first, opts) {
+                continue;
+            }
+            if let Some(truth) = locate(&self.truth[start..start + len], base, aligned, max_gap) {
+                let g = geodesic(&truth.q, &q);
+                sum += g * g;
+                n += 1;
+            }
+        }
+        if n == 0 {
+            f64::INFINITY
+        } else {
+            sum / n as f64
+        }
+    }
 }
 
 /// The minimiser of `f` on `[lo, hi]` to within `tol`, by golden-section search.

@@ -10,7 +10,8 @@
 //! | `perturbation.csv` | `t_ns,mag_x,mag_y,mag_z` | ns |
 //! | `marg.csv` | `t_ns,acc_x..acc_z,mag_x..mag_z` | ns |
 //!
-//! Quaternions are normalised; a zero or non-finite one is an error at its line.
+//! Quaternions are normalised; a zero or non-finite one is an error at its line, except in
+//! `dut_attitude.csv`, where such a row (a device's fault) is skipped and counted.
 
 use super::quat::{normalize, Quat};
 use super::score::Stamped;
@@ -51,6 +52,8 @@ pub struct Imu {
 pub struct DutRow {
     /// Line in the file.
     pub line: u64,
+    /// Its message stream: the index in [`DutAttitude::messages`].
+    pub stream: usize,
     /// Host arrival time (ns, the session's monotonic clock).
     pub host_ns: i64,
     /// The device's own time stamp (µs), when it sent one.
@@ -61,13 +64,50 @@ pub struct DutRow {
     pub q: Quat,
 }
 
-/// `dut_attitude.csv`: the rows kept and what else was there.
+/// `dut_attitude.csv`: its rows with a usable quaternion, and what else was there.
 #[derive(Clone, Debug, Default)]
 pub struct DutAttitude {
-    /// Rows of the selected message (all rows without a filter).
+    /// Rows with a usable quaternion, in file order.
     pub rows: Vec<DutRow>,
-    /// Rows per `protocol/message`, in order of first appearance.
+    /// Message streams: rows per `protocol/message`, in order of first appearance.
     pub messages: Vec<(String, usize)>,
+    /// The `message` column of each stream.
+    pub message_names: Vec<String>,
+    /// The stream of each row whose quaternion is unusable (zero, near zero or not finite: a
+    /// device's fault, skipped and counted rather than refused).
+    pub unusable: Vec<usize>,
+}
+
+/// Message names by how exactly they carry an attitude, best first: a quaternion as the device
+/// computed it, then float Euler angles, then Euler angles in 0.1°.
+pub const MESSAGE_PREFERENCE: [&str; 3] = ["ATTITUDE_QUATERNION", "ATTITUDE", "MSP_ATTITUDE"];
+
+impl DutAttitude {
+    /// The streams whose `message` is `message`.
+    pub fn streams_of(&self, message: &str) -> Vec<usize> {
+        (0..self.message_names.len())
+            .filter(|&i| self.message_names[i] == message)
+            .collect()
+    }
+
+    /// The one stream to score when none is chosen: a device sends one sample's attitude in
+    /// several messages (MAVLink's ATTITUDE and ATTITUDE_QUATERNION with one time stamp), and
+    /// scoring them together would count each sample twice. Of the streams with usable rows
+    /// (of all, when none has any), the one whose message comes first in
+    /// [`MESSAGE_PREFERENCE`] (others after), then the one with most usable rows.
+    pub fn preferred_stream(&self) -> Option<usize> {
+        let usable = |i: usize| self.rows.iter().filter(|r| r.stream == i).count();
+        let rank = |i: usize| {
+            MESSAGE_PREFERENCE
+                .iter()
+                .position(|m| *m == self.message_names[i])
+                .unwrap_or(MESSAGE_PREFERENCE.len())
+        };
+        (0..self.messages.len()).min_by_key(|&i| {
+            let n = usable(i);
+            (n == 0, rank(i), std::cmp::Reverse(n), i)
+        })
+    }
 }
 
 /// An external recording: IMU samples, the reference attitude and, optionally, an estimate.
@@ -81,19 +121,45 @@ pub struct External {
     pub estimate: Option<Vec<Stamped>>,
 }
 
-fn unit(row: &Row<'_>, q: Quat) -> Result<Quat, ColumnError> {
+/// `q` normalised, or an error at `row` when it has no direction.
+pub(super) fn unit(row: &Row<'_>, q: Quat) -> Result<Quat, ColumnError> {
     let u = normalize(q)
         .ok_or_else(|| row.error(format!("quaternion {q:?} has no direction (zero norm)")))?;
     let c = u.into_inner();
     Ok([c.w, c.i, c.j, c.k])
 }
 
-fn seconds_to_ns(row: &Row<'_>, col: usize) -> Result<u64, ColumnError> {
+/// Column `col` (seconds) as integer nanoseconds.
+pub(super) fn seconds_to_ns(row: &Row<'_>, col: usize) -> Result<u64, ColumnError> {
     let t = row.f64(col)?;
     if t < 0.0 || t * 1e9 >= u64::MAX as f64 {
         return Err(row.error(format!("`t_s` = {t} is outside 0 to 1.8e10 s")));
     }
     Ok((t * 1e9).round() as u64)
+}
+
+/// Integer nanoseconds as seconds, for messages about a seconds column (`0.01`).
+pub fn seconds(ns: u64) -> f64 {
+    ns as f64 / 1e9
+}
+
+/// An error unless `t_ns`, read from the seconds column `col`, is after `previous_ns`; the
+/// message gives both in seconds, as the column has them.
+pub(super) fn check_seconds_order(
+    row: &Row<'_>,
+    col: usize,
+    previous_ns: Option<u64>,
+    t_ns: u64,
+) -> Result<(), ColumnError> {
+    match previous_ns {
+        Some(p) if t_ns <= p => Err(row.error(format!(
+            "`{}` = {} does not increase (previous row: {})",
+            row.name(col),
+            seconds(t_ns),
+            seconds(p)
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// Reads `truth.csv` as `simulate`, `stream` and `loopback` write it.
@@ -119,8 +185,8 @@ pub fn read_truth(path: &Path) -> Result<TruthRun, ColumnError> {
     Ok(run)
 }
 
-/// Reads `dut_attitude.csv`, keeping the rows whose `message` is `message` (all without one).
-pub fn read_dut_attitude(path: &Path, message: Option<&str>) -> Result<DutAttitude, ColumnError> {
+/// Reads `dut_attitude.csv`: every row with a usable quaternion, the others counted.
+pub fn read_dut_attitude(path: &Path) -> Result<DutAttitude, ColumnError> {
     let table = Table::open(path)?;
     let [host, protocol, msg, device] =
         table.columns(["host_ns", "protocol", "message", "device_time_us"])?;
@@ -133,19 +199,31 @@ pub fn read_dut_attitude(path: &Path, message: Option<&str>) -> Result<DutAttitu
         row.check_order(host, last_host, host_ns, false)?;
         last_host = Some(host_ns);
         let name = format!("{}/{}", row.text(protocol), row.text(msg));
-        match out.messages.iter_mut().find(|m| m.0 == name) {
-            Some(m) => m.1 += 1,
-            None => out.messages.push((name, 1)),
+        let stream = match out.messages.iter().position(|m| m.0 == name) {
+            Some(i) => i,
+            None => {
+                out.messages.push((name, 0));
+                out.message_names.push(row.text(msg).to_owned());
+                out.messages.len() - 1
+            }
+        };
+        out.messages[stream].1 += 1;
+        let mut raw = [0.0; 4];
+        for (r, &col) in raw.iter_mut().zip(&q) {
+            *r = row.any_f64(col)?;
         }
-        if message.is_some_and(|m| m != row.text(msg)) {
+        let Some(unit) = normalize(raw) else {
+            out.unusable.push(stream);
             return Ok(());
-        }
+        };
+        let c = unit.into_inner();
         out.rows.push(DutRow {
             line: row.line(),
+            stream,
             host_ns,
             device_time_us: row.opt_f64(device)?,
             euler: row.f64s(e)?,
-            q: unit(row, row.f64s(q)?)?,
+            q: [c.w, c.i, c.j, c.k],
         });
         Ok(())
     })?;
@@ -160,7 +238,7 @@ pub fn read_estimates(path: &Path) -> Result<Vec<Stamped>, ColumnError> {
     let mut out: Vec<Stamped> = Vec::new();
     table.for_each(|row| {
         let t_ns = seconds_to_ns(row, t)?;
-        row.check_order(t, out.last().map(|s| s.0), t_ns, true)?;
+        check_seconds_order(row, t, out.last().map(|s| s.0), t_ns)?;
         out.push((t_ns, unit(row, row.f64s(q)?)?));
         Ok(())
     })?;
@@ -187,7 +265,7 @@ pub fn read_external(path: &Path) -> Result<External, ColumnError> {
     };
     table.for_each(|row| {
         let t_ns = seconds_to_ns(row, t)?;
-        row.check_order(t, out.imu.t_ns.last().copied(), t_ns, true)?;
+        check_seconds_order(row, t, out.imu.t_ns.last().copied(), t_ns)?;
         out.imu.t_ns.push(t_ns);
         out.imu.acc.push(row.f64s(acc)?);
         out.imu.gyr.push(row.f64s(gyr)?);
@@ -214,6 +292,67 @@ pub fn read_external(path: &Path) -> Result<External, ColumnError> {
     Ok(out)
 }
 
+/// A row of [`VectorRows`]: its instant (ns) and a vector per group.
+pub(crate) type VectorRow<const G: usize> = (u64, [[f64; 3]; G]);
+
+/// `t_ns` and three-column groups of a simulation's CSV (`perturbation.csv`, `marg.csv`), read
+/// a row at a time, `t_ns` strictly increasing.
+pub(crate) struct VectorRows<const G: usize> {
+    table: Table,
+    t: usize,
+    cols: [[usize; 3]; G],
+    last: Option<u64>,
+    ahead: Option<VectorRow<G>>,
+}
+
+impl<const G: usize> VectorRows<G> {
+    /// Opens `path` and finds its columns.
+    pub(crate) fn open(path: &Path, groups: [[&str; 3]; G]) -> Result<Self, ColumnError> {
+        let table = Table::open(path)?;
+        let t = table.column("t_ns")?;
+        let mut cols = [[0usize; 3]; G];
+        for (c, names) in cols.iter_mut().zip(groups) {
+            *c = table.columns(names)?;
+        }
+        Ok(Self {
+            table,
+            t,
+            cols,
+            last: None,
+            ahead: None,
+        })
+    }
+
+    /// The next row: its instant and a vector per group.
+    pub(crate) fn next(&mut self) -> Result<Option<VectorRow<G>>, ColumnError> {
+        if let Some(row) = self.ahead.take() {
+            return Ok(Some(row));
+        }
+        let Some(row) = self.table.next_row()? else {
+            return Ok(None);
+        };
+        let t: u64 = row.int(self.t)?;
+        row.check_order(self.t, self.last, t, true)?;
+        let mut values = [[0.0; 3]; G];
+        for (v, c) in values.iter_mut().zip(self.cols) {
+            *v = row.f64s(c)?;
+        }
+        self.last = Some(t);
+        Ok(Some((t, values)))
+    }
+
+    /// The row at instant `t` if there is one; `t` must increase from call to call.
+    pub(crate) fn at(&mut self, t: u64) -> Result<Option<[[f64; 3]; G]>, ColumnError> {
+        while let Some((s, values)) = self.next()? {
+            if s >= t {
+                self.ahead = Some((s, values));
+                return Ok((s == t).then_some(values));
+            }
+        }
+        Ok(None)
+    }
+}
+
 /// Instants (ns) and, per group of three columns, one vector per row.
 pub type Vectors<const G: usize> = (Vec<u64>, [Vec<[f64; 3]>; G]);
 
@@ -222,22 +361,26 @@ pub fn read_vectors<const G: usize>(
     path: &Path,
     groups: [[&str; 3]; G],
 ) -> Result<Vectors<G>, ColumnError> {
-    let table = Table::open(path)?;
-    let t = table.column("t_ns")?;
-    let mut cols = [[0usize; 3]; G];
-    for (c, names) in cols.iter_mut().zip(groups) {
-        *c = table.columns(names)?;
-    }
+    let mut rows = VectorRows::open(path, groups)?;
     let mut times: Vec<u64> = Vec::new();
     let mut values: [Vec<[f64; 3]>; G] = core::array::from_fn(|_| Vec::new());
-    table.for_each(|row| {
-        let t_ns: u64 = row.int(t)?;
-        row.check_order(t, times.last().copied(), t_ns, true)?;
-        times.push(t_ns);
-        for (v, c) in values.iter_mut().zip(cols) {
-            v.push(row.f64s(c)?);
+    while let Some((t, row)) = rows.next()? {
+        times.push(t);
+        for (v, r) in values.iter_mut().zip(row) {
+            v.push(r);
         }
-        Ok(())
-    })?;
+    }
     Ok((times, values))
+}
+
+/// The first sample of `truth.csv` (its instant and attitude, normalised), `None` when it has
+/// no data row; the rest of the file is not read.
+pub fn read_first_attitude(path: &Path) -> Result<Option<Stamped>, ColumnError> {
+    let mut table = Table::open(path)?;
+    let t = table.column("t_ns")?;
+    let q = table.columns(["qw", "qx", "qy", "qz"])?;
+    let Some(row) = table.next_row()? else {
+        return Ok(None);
+    };
+    Ok(Some((row.int(t)?, unit(&row, row.f64s(q)?)?)))
 }

@@ -79,22 +79,51 @@ pub struct PhaseSample {
     pub field: f64,
 }
 
+/// What the rules see of one instant, before the window: whether its field is perturbed and
+/// whether it is quiet (slow and unaccelerated). One byte per instant, for long runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Marks {
+    /// The field deviation is above the threshold.
+    pub perturbed: bool,
+    /// Body rate and external acceleration are below theirs.
+    pub quiet: bool,
+}
+
+impl Marks {
+    /// The marks of `sample` under `rules`.
+    pub fn of(sample: &PhaseSample, rules: &PhaseRules) -> Self {
+        Self {
+            perturbed: sample.field > rules.magnetic_fraction,
+            quiet: sample.rate < rules.static_rate && sample.accel < rules.static_accel,
+        }
+    }
+}
+
 /// The phase of every sample, `step_ns` apart.
 pub fn classify(samples: &[PhaseSample], rules: &PhaseRules, step_ns: u64) -> Vec<Phase> {
+    let marks: Vec<Marks> = samples.iter().map(|s| Marks::of(s, rules)).collect();
+    classify_marks(&marks, rules, step_ns)
+}
+
+/// The phase of every instant from its marks, `step_ns` apart: magnetic when some instant
+/// within half a window is perturbed (a count of perturbed instants slid along), else static
+/// when quiet, else dynamic.
+pub fn classify_marks(marks: &[Marks], rules: &PhaseRules, step_ns: u64) -> Vec<Phase> {
     let half = (rules.window_ns / 2 / step_ns.max(1)) as usize;
-    let perturbed: Vec<[f64; 1]> = samples
-        .iter()
-        .map(|s| [f64::from(u8::from(s.field > rules.magnetic_fraction))])
-        .collect();
-    // A mean above zero over the window: some instant in it is perturbed.
-    let near = moving_mean(&perturbed, half);
-    samples
-        .iter()
-        .zip(near)
-        .map(|(s, near)| {
-            if near[0] > 0.0 {
+    let n = marks.len();
+    let perturbed = |i: usize| usize::from(marks[i].perturbed);
+    let mut near = (0..half.min(n)).map(perturbed).sum::<usize>();
+    (0..n)
+        .map(|i| {
+            if let Some(k) = i.checked_add(half).filter(|&k| k < n) {
+                near += perturbed(k);
+            }
+            if i > half {
+                near -= perturbed(i - half - 1);
+            }
+            if near > 0 {
                 Phase::Magnetic
-            } else if s.rate < rules.static_rate && s.accel < rules.static_accel {
+            } else if marks[i].quiet {
                 Phase::Static
             } else {
                 Phase::Dynamic
@@ -154,6 +183,39 @@ mod tests {
         // 20 ms apart: the perturbation at sample 3 marks the two before it too.
         let phases = classify(&samples, &rules, 20_000_000);
         assert_eq!(phases, [Static, Magnetic, Magnetic, Magnetic]);
+    }
+
+    #[test]
+    fn the_sliding_count_marks_what_a_window_mean_marks() {
+        // Perturbed instants in a pattern with runs and gaps of several lengths.
+        let marks: Vec<Marks> = (0..200u32)
+            .map(|i| Marks {
+                perturbed: (i * 7919) % 23 < 2 || (90..95).contains(&i),
+                quiet: i % 3 == 0,
+            })
+            .collect();
+        let flags: Vec<[f64; 1]> = marks
+            .iter()
+            .map(|m| [f64::from(u8::from(m.perturbed))])
+            .collect();
+        let rules = PhaseRules::default();
+        for step_ns in [1_000_000_000, 50_000_000, 10_000_000, 3_000_000, 1_000_000] {
+            let half = (rules.window_ns / 2 / step_ns) as usize;
+            let expected: Vec<Phase> = moving_mean(&flags, half)
+                .iter()
+                .zip(&marks)
+                .map(|(near, m)| match (near[0] > 0.0, m.quiet) {
+                    (true, _) => Phase::Magnetic,
+                    (false, true) => Phase::Static,
+                    (false, false) => Phase::Dynamic,
+                })
+                .collect();
+            assert_eq!(
+                classify_marks(&marks, &rules, step_ns),
+                expected,
+                "{step_ns}"
+            );
+        }
     }
 
     #[test]

@@ -6,17 +6,16 @@
 //! - `alignment.{png,svg}`: the mean squared geodesic error against the lag tried, with the lag
 //!   found.
 //!
-//! Long series are thinned to the minimum and maximum of each of about 2000 buckets, so spikes
-//! survive; angle curves are broken where they wrap at ±180°.
+//! Long series come thinned ([`super::thin`]): the lowest and highest point of each of about
+//! 2000 time buckets, so spikes survive; angle curves are broken where they wrap at ±180°.
 
-use super::phase::{runs, Phase};
+use super::phase::Phase;
 use super::run::Evaluation;
 use crate::analysis::plot::{render, DrawResult, Figure, PlotError};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
-const BUCKETS: usize = 2000;
 const TRUTH: RGBColor = RGBColor(31, 90, 200);
 const ESTIMATE: RGBColor = RGBColor(215, 40, 40);
 const STATIC_SHADE: RGBColor = RGBColor(225, 225, 225);
@@ -36,42 +35,6 @@ pub fn write(eval: &Evaluation, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
         }
     }
     Ok(written)
-}
-
-/// At most about `2 · BUCKETS` points: the minimum and maximum of each bucket, in time order.
-fn thin(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
-    if points.len() <= 2 * BUCKETS {
-        return points.to_vec();
-    }
-    let size = points.len().div_ceil(BUCKETS);
-    points
-        .chunks(size)
-        .flat_map(|c| {
-            let lo = c.iter().min_by(|a, b| a.1.total_cmp(&b.1)).copied();
-            let hi = c.iter().max_by(|a, b| a.1.total_cmp(&b.1)).copied();
-            let (lo, hi) = (lo.unwrap_or_default(), hi.unwrap_or_default());
-            if lo.0 <= hi.0 {
-                [lo, hi]
-            } else {
-                [hi, lo]
-            }
-        })
-        .collect()
-}
-
-/// Pieces of an angle curve (degrees) between jumps of more than 180°, each thinned.
-fn unwrapped_pieces(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
-    let mut pieces: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for w in points.windows(2) {
-        pieces.last_mut().expect("never empty").push(w[0]);
-        if (w[1].1 - w[0].1).abs() > 180.0 {
-            pieces.push(Vec::new());
-        }
-    }
-    if let Some(&last) = points.last() {
-        pieces.last_mut().expect("never empty").push(last);
-    }
-    pieces.iter().map(|p| thin(p)).collect()
 }
 
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -113,15 +76,12 @@ impl Attitude<'_> {
             .y_desc(label)
             .x_desc("t (s)")
             .draw()?;
-        let eval = self.0;
-        let t = eval.reference.t_ns();
-        for (phase, first, last) in runs(&eval.phases) {
+        for &(phase, a, b) in &self.0.traces.phases {
             let shade = match phase {
                 Phase::Static => STATIC_SHADE,
                 Phase::Magnetic => MAGNETIC_SHADE,
                 Phase::Dynamic => continue,
             };
-            let (a, b) = (t[first] as f64 * 1e-9, t[last] as f64 * 1e-9);
             chart.draw_series(std::iter::once(Rectangle::new(
                 [(a, y_lo), (b, y_hi)],
                 shade.filled(),
@@ -153,50 +113,33 @@ impl Figure for Attitude<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         let eval = self.0;
         root.fill(&WHITE)?;
-        let t = eval.reference.t_ns();
-        let x = range([t[0], t[t.len() - 1]].iter().map(|&v| v as f64 * 1e-9));
+        let traces = &eval.traces;
+        let x = range([traces.span_s.0, traces.span_s.1].into_iter());
         let rows = root.split_evenly((5, 1));
         let names = ["roll (°)", "pitch (°)", "yaw (°)"];
         for (i, name) in names.iter().enumerate() {
-            let truth: Vec<(f64, f64)> = t
-                .iter()
-                .zip(eval.reference.euler())
-                .map(|(&t, e)| (t as f64 * 1e-9, e[i].to_degrees()))
-                .collect();
-            let est: Vec<(f64, f64)> = eval
-                .compared
-                .iter()
-                .map(|c| (c.t_ns as f64 * 1e-9, c.estimate[i].to_degrees()))
-                .collect();
-            let (truth, est) = (unwrapped_pieces(&truth), unwrapped_pieces(&est));
             self.panel(
                 &rows[i],
                 name,
                 x,
-                &[(&truth, TRUTH, "truth"), (&est, ESTIMATE, "estimate")],
+                &[
+                    (&traces.truth[i], TRUTH, "truth"),
+                    (&traces.estimate[i], ESTIMATE, "estimate"),
+                ],
             )?;
         }
         let n = &eval.norms;
-        let series = |v: &[f64]| {
-            vec![thin(
-                &n.t_ns
-                    .iter()
-                    .zip(v)
-                    .map(|(&t, &v)| (t as f64 * 1e-9, v))
-                    .collect::<Vec<_>>(),
-            )]
-        };
         self.panel(
             &rows[3],
             "|accelerometer| (m/s²)",
             x,
-            &[(&series(&n.acc), BLACK, "")],
+            &[(&n.acc.pieces(), BLACK, "")],
         )?;
         self.panel(
             &rows[4],
             "|magnetometer|",
             x,
-            &[(&series(&n.mag), BLACK, "")],
+            &[(&n.mag.pieces(), BLACK, "")],
         )
     }
 }

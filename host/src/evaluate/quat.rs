@@ -9,11 +9,15 @@ use nalgebra::{Quaternion, UnitQuaternion};
 /// A unit quaternion `[w, x, y, z]`.
 pub type Quat = [f64; 4];
 
-/// `q` scaled to unit norm, or `None` when its norm is zero or it is not finite.
+/// Norm below which a quaternion carries no attitude: its direction would be rounding noise
+/// (`(1e-30, 1e-30, 0, 0)` is no 90° roll).
+pub const MIN_NORM: f64 = 1e-6;
+
+/// `q` scaled to unit norm, or `None` when its norm is below [`MIN_NORM`] or it is not finite.
 pub fn normalize(q: Quat) -> Option<UnitQuaternion<f64>> {
     let raw = Quaternion::new(q[0], q[1], q[2], q[3]);
     let norm = raw.norm();
-    (norm.is_finite() && norm > 1e-12).then(|| UnitQuaternion::new_unchecked(raw / norm))
+    (norm.is_finite() && norm >= MIN_NORM).then(|| UnitQuaternion::new_unchecked(raw / norm))
 }
 
 /// ZYX Euler angles `[roll, pitch, yaw]` of `q` (`R = Rz(ψ) Ry(θ) Rx(φ)`).
@@ -103,6 +107,21 @@ mod tests {
             assert!(geodesic(&ours, &theirs) < 1e-12, "{s}");
         }
         assert!((geodesic(&a, &b) - a.angle_to(&b)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn normalize_refuses_what_has_no_direction() {
+        for q in [
+            [0.0; 4],
+            [1e-30, 1e-30, 0.0, 0.0],
+            [f64::NAN, 0.0, 0.0, 1.0],
+            [f64::INFINITY, 0.0, 0.0, 0.0],
+        ] {
+            assert!(normalize(q).is_none(), "{q:?}");
+        }
+        let u = normalize([0.0, 2.0, 0.0, 0.0]).unwrap();
+        assert_eq!([u.w, u.i, u.j, u.k], [0.0, 1.0, 0.0, 0.0]);
+        assert!(normalize([1e-3, 0.0, 0.0, 0.0]).is_some());
     }
 
     #[test]

@@ -4,12 +4,14 @@
 //! The score table follows the paper's Table 3: rows `F`, `MSE` and `STD` per angle (rad², rad),
 //! then the geodesic RMS and maximum; one column per phase, after the whole run.
 //!
-//! `errors.csv` (one row per scored estimate, `t_ns` its aligned instant): `t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic`
+//! `errors.csv` (one row per scored estimate, written as it is scored by
+//! [`evaluate_writing`](super::run::evaluate_writing); `t_ns` its aligned instant in
+//! nanoseconds): `t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic`
 //! (rad; `e = wrap(true − estimate)`).
 
 use super::phase::Phase;
 use super::run::{Clock, EvalError, Evaluation};
-use super::score::Scores;
+use super::score::{Compared, Scores};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -177,7 +179,7 @@ pub fn markdown(eval: &Evaluation, dir: &Path, figures: &[PathBuf]) -> String {
     md
 }
 
-/// Every file [`write()`] may write.
+/// Every file [`write()`] and [`evaluate_writing`](super::run::evaluate_writing) may write.
 pub const FILES: [&str; 6] = [
     "errors.csv",
     "report.md",
@@ -187,32 +189,75 @@ pub const FILES: [&str; 6] = [
     "alignment.svg",
 ];
 
-/// Writes `errors.csv`, the figures and `report.md` into `dir`; returns the files written.
+/// The columns of `errors.csv`.
+pub const ERRORS_HEADER: &str =
+    "t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic";
+
+/// `errors.csv` being written, one scored instant at a time.
+pub(super) struct ErrorsCsv {
+    path: PathBuf,
+    out: std::io::BufWriter<std::fs::File>,
+}
+
+impl ErrorsCsv {
+    /// Creates the file (and its directory) and writes the header.
+    pub(super) fn create(path: &Path) -> Result<Self, EvalError> {
+        let fail = |error| EvalError::Write {
+            path: path.to_path_buf(),
+            error,
+        };
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(fail)?;
+        }
+        let file = std::fs::File::create(path).map_err(fail)?;
+        let mut out = std::io::BufWriter::with_capacity(1 << 16, file);
+        writeln!(out, "{ERRORS_HEADER}").map_err(fail)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            out,
+        })
+    }
+
+    /// Writes one scored instant (`phase`: of its nearest truth instant).
+    pub(super) fn row(&mut self, c: &Compared, phase: Option<Phase>) -> Result<(), EvalError> {
+        let phase = phase.map_or("", Phase::name);
+        let [t, e, r] = [c.truth, c.estimate, c.error];
+        writeln!(
+            self.out,
+            "{},{phase},{},{},{},{},{},{},{},{},{},{}",
+            c.t_ns, t[0], t[1], t[2], e[0], e[1], e[2], r[0], r[1], r[2], c.geodesic
+        )
+        .map_err(|error| EvalError::Write {
+            path: self.path.clone(),
+            error,
+        })
+    }
+
+    /// Flushes the file.
+    pub(super) fn finish(mut self) -> Result<(), EvalError> {
+        self.out.flush().map_err(|error| EvalError::Write {
+            path: self.path.clone(),
+            error,
+        })
+    }
+
+    /// Removes the unfinished file.
+    pub(super) fn discard(self) {
+        let path = self.path.clone();
+        drop(self);
+        let _ = std::fs::remove_file(path);
+    }
+}
+
+/// Writes the figures and `report.md` into `dir`; returns the files written, `errors.csv`
+/// first when the evaluation wrote one.
 pub fn write(eval: &Evaluation, dir: &Path, plots: bool) -> Result<Vec<PathBuf>, EvalError> {
     let write_err = |path: &Path| {
         let path = path.to_path_buf();
         move |error| EvalError::Write { path, error }
     };
     std::fs::create_dir_all(dir).map_err(write_err(dir))?;
-    let errors = dir.join("errors.csv");
-    let mut out =
-        std::io::BufWriter::new(std::fs::File::create(&errors).map_err(write_err(&errors))?);
-    let mut text = String::from(
-        "t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic\n",
-    );
-    for c in &eval.compared {
-        let phase = eval.phases.get(c.index).map_or("", |p| p.name());
-        let [t, e, r] = [c.truth, c.estimate, c.error];
-        let _ = writeln!(
-            text,
-            "{},{phase},{},{},{},{},{},{},{},{},{},{}",
-            c.t_ns, t[0], t[1], t[2], e[0], e[1], e[2], r[0], r[1], r[2], c.geodesic
-        );
-    }
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(write_err(&errors))?;
-    let mut written = vec![errors];
+    let mut written: Vec<PathBuf> = eval.errors_csv.iter().cloned().collect();
     let figures = if plots {
         super::plot::write(eval, dir)?
     } else {

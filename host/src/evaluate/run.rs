@@ -1,13 +1,21 @@
 //! One evaluation from files: reads a source (module `load`), aligns the estimates, scores
-//! them overall and per phase, and keeps what the report and the figures need. The in-process
-//! scoring functions ([`score`](mod@super::score)) do the numbers; this module only feeds them.
+//! them overall and per phase in one pass that writes `errors.csv` row by row, and keeps what
+//! the report and the figures need (statistics gathered online, traces thinned), so memory
+//! does not grow with the length of the run. The arithmetic is that of the in-process scoring
+//! functions ([`score`](mod@super::score)).
 
-use super::align::{estimate_latency, ClockFit, Latency, LatencySearch};
+use super::align::{latency_of_series, ClockFit, Latency, LatencySearch};
 use super::device_log::SessionFileError;
-use super::phase::{classify, Phase, PhaseRules};
-use super::score::{Compared, Estimates, Reference, ScoreError, ScoreOptions, Scores};
+use super::load::Loaded;
+use super::phase::{Phase, PhaseRules};
+use super::quat::euler;
+use super::report::ErrorsCsv;
+use super::score::{after_warmup, compared, locate, Sample, ScoreError, ScoreOptions, Scores};
+use super::stats::Accumulator;
+use super::thin::{Pieces, Thinner};
+use super::walk::Walk;
 use crate::csv_column::ColumnError;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// What to evaluate.
 #[derive(Clone, Debug, PartialEq)]
@@ -138,17 +146,46 @@ pub enum Clock {
     Unusable(String),
 }
 
-/// Accelerometer and magnetometer norms for the figures.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// Accelerometer and magnetometer norms for the figures, thinned.
+#[derive(Clone, Debug, Default)]
 pub struct Norms {
     /// Where they come from.
     pub source: String,
-    /// Instants (ns, scene axis).
-    pub t_ns: Vec<u64>,
-    /// `|a|` (m/s²).
-    pub acc: Vec<f64>,
-    /// `|m|` (field unit).
-    pub mag: Vec<f64>,
+    /// `|a|` (m/s²) against time (s).
+    pub acc: Thinner,
+    /// `|m|` (field unit) against time (s).
+    pub mag: Thinner,
+}
+
+impl Norms {
+    /// No norms yet, from `source`.
+    pub fn new(source: &str) -> Self {
+        Self {
+            source: source.to_owned(),
+            ..Self::default()
+        }
+    }
+
+    /// Adds the norms of one sample at `t_ns`.
+    pub fn push(&mut self, t_ns: u64, acc: &[f64; 3], mag: &[f64; 3]) {
+        let norm = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let t = t_ns as f64 * 1e-9;
+        self.acc.push(t, norm(acc));
+        self.mag.push(t, norm(mag));
+    }
+}
+
+/// The attitudes the figures draw, thinned, with the phases to shade.
+#[derive(Clone, Debug, Default)]
+pub struct Traces {
+    /// First and last truth instant (s).
+    pub span_s: (f64, f64),
+    /// Truth roll, pitch and yaw (°) at every truth instant.
+    pub truth: [Pieces; 3],
+    /// Estimated roll, pitch and yaw (°) at every scored instant (aligned).
+    pub estimate: [Pieces; 3],
+    /// Runs of equal phase: `(phase, first instant s, last instant s)`.
+    pub phases: Vec<(Phase, f64, f64)>,
 }
 
 /// Everything one evaluation found.
@@ -158,8 +195,6 @@ pub struct Evaluation {
     pub inputs: Vec<String>,
     /// Notes on the input (dropped rows, consistency).
     pub notes: Vec<String>,
-    /// The truth.
-    pub reference: Reference,
     /// The phase of every truth instant.
     pub phases: Vec<Phase>,
     /// The latency search (`None` when no lag overlapped).
@@ -170,8 +205,6 @@ pub struct Evaluation {
     pub latency_reason: String,
     /// The device clock.
     pub clock: Clock,
-    /// Every scored instant.
-    pub compared: Vec<Compared>,
     /// Scores over every scored instant.
     pub scores: Scores,
     /// Scores per phase (`None`: no instant of that phase).
@@ -180,26 +213,32 @@ pub struct Evaluation {
     pub options: EvalOptions,
     /// Norms for the figures.
     pub norms: Norms,
+    /// Attitudes for the figures.
+    pub traces: Traces,
+    /// `errors.csv`, when it was written.
+    pub errors_csv: Option<PathBuf>,
 }
 
-/// Runs one evaluation (see the module docs).
+/// Runs one evaluation (see the module docs) without writing `errors.csv`.
 pub fn evaluate(source: &Source, options: &EvalOptions) -> Result<Evaluation, EvalError> {
-    let incomplete = match source {
-        Source::Session(dir) | Source::Estimates { dir, .. } => {
-            crate::rundir::check_complete(dir, options.allow_incomplete)?
-        }
-        Source::External { .. } => None,
-    };
-    let mut loaded = super::load::load(source, options)?;
-    loaded.notes.extend(incomplete);
-    let context = || loaded.inputs.join(", ");
-    let scored = |reason| EvalError::Score {
-        context: context(),
-        reason,
-    };
-    let reference = Reference::new(&loaded.truth).map_err(scored)?;
-    let estimates = Estimates::new(&loaded.estimates).map_err(scored)?;
-    let latency = estimate_latency(&reference, &estimates, &options.search);
+    evaluate_writing(source, options, None)
+}
+
+/// Runs one evaluation, writing every scored instant to `errors_csv` (see
+/// [`report`](super::report)) as it is scored, when given; its directory is created.
+pub fn evaluate_writing(
+    source: &Source,
+    options: &EvalOptions,
+    errors_csv: Option<&Path>,
+) -> Result<Evaluation, EvalError> {
+    let loaded = super::load::load(source, options)?;
+    let latency = latency_of_series(
+        &loaded.truth,
+        &loaded.facts,
+        &loaded.estimates,
+        loaded.estimate_extent.count,
+        &options.search,
+    )?;
     let mode = options.latency.unwrap_or(loaded.default_latency);
     let (latency_applied_ns, latency_reason) = match (mode, &latency) {
         (LatencyMode::Fixed(ns), _) => (ns, "fixed by the caller".to_string()),
@@ -214,33 +253,128 @@ pub fn evaluate(source: &Source, options: &EvalOptions) -> Result<Evaluation, Ev
         latency_ns: latency_applied_ns,
         ..options.search.score
     };
-    let compared = reference.compare(&estimates, &opts).map_err(scored)?;
-    let scores = Scores::from_compared(compared.iter()).expect("compare returns at least one");
-    let phases = classify(
-        &loaded.phase_samples,
-        &options.rules,
-        reference.median_step_ns(),
-    );
+    let mut errors = errors_csv.map(ErrorsCsv::create).transpose()?;
+    let scored = score_pass(&loaded, &opts, errors.as_mut());
+    let scored = match (scored, errors) {
+        (Ok(s), Some(e)) => e.finish().map(|()| s),
+        (Ok(s), None) => Ok(s),
+        (Err(e), written) => {
+            if let Some(w) = written {
+                w.discard();
+            }
+            Err(e)
+        }
+    }?;
+    let Some(scores) = scored.all.scores() else {
+        if let Some(path) = errors_csv {
+            let _ = std::fs::remove_file(path);
+        }
+        return Err(EvalError::Score {
+            context: loaded.inputs.join(", "),
+            reason: ScoreError::NoOverlap {
+                truth: loaded.truth_extent.span(0),
+                estimate: loaded.estimate_extent.span(opts.latency_ns),
+                warmup_s: opts.warmup_ns as f64 * 1e-9,
+            },
+        });
+    };
     let by_phase = Phase::ALL
         .iter()
-        .map(|&p| {
-            let of_phase = compared.iter().filter(|c| phases.get(c.index) == Some(&p));
-            (p, Scores::from_compared(of_phase))
-        })
+        .zip(&scored.by_phase)
+        .map(|(&p, acc)| (p, acc.scores()))
         .collect();
     Ok(Evaluation {
         inputs: loaded.inputs,
         notes: loaded.notes,
-        reference,
-        phases,
+        phases: loaded.phases,
         latency,
         latency_applied_ns,
         latency_reason,
         clock: loaded.clock,
-        compared,
         scores,
         by_phase,
         options: options.clone(),
         norms: loaded.norms,
+        traces: scored.traces,
+        errors_csv: errors_csv.map(Path::to_path_buf),
+    })
+}
+
+/// What the scoring pass gathered.
+struct Scored {
+    all: Accumulator,
+    by_phase: [Accumulator; 3],
+    traces: Traces,
+}
+
+/// Scores every estimate at the latency of `opts` in one pass over the truth and the
+/// estimates, writing each scored instant to `errors` and thinning the traces as it goes.
+fn score_pass(
+    loaded: &Loaded,
+    opts: &ScoreOptions,
+    mut errors: Option<&mut ErrorsCsv>,
+) -> Result<Scored, EvalError> {
+    let max_gap = loaded.facts.max_gap_ns(opts);
+    let first = loaded.facts.first_ns;
+    let phases = &loaded.phases;
+    let mut truth_traces = [Thinner::angles(), Thinner::angles(), Thinner::angles()];
+    let mut estimate_traces = truth_traces.clone();
+    let mut runs: Vec<(Phase, f64, f64)> = Vec::new();
+    let mut on_read = |i: usize, s: &Sample| {
+        let t = s.0 as f64 * 1e-9;
+        let e = euler(&s.1);
+        for (trace, angle) in truth_traces.iter_mut().zip(e) {
+            trace.push(t, angle.to_degrees());
+        }
+        if let Some(&p) = phases.get(i) {
+            match runs.last_mut() {
+                Some(run) if run.0 == p => run.2 = t,
+                _ => runs.push((p, t, t)),
+            }
+        }
+    };
+    let mut all = Accumulator::default();
+    let mut by_phase = [Accumulator::default(); 3];
+    let mut walk = Walk::new(&loaded.truth)?;
+    for estimate in loaded.estimates.read()? {
+        let (stamp, q) = estimate?;
+        let aligned = stamp as i64 - opts.latency_ns;
+        let (window, base) = walk.cover(aligned, aligned, &mut on_read)?;
+        if !after_warmup(aligned, first, opts) {
+            continue;
+        }
+        let Some(located) = locate(window, base, aligned, max_gap) else {
+            continue;
+        };
+        let c = compared(
+            &located,
+            euler(&located.q),
+            (stamp, &q, euler(&q)),
+            opts.latency_ns,
+        );
+        let phase = phases.get(c.index).copied();
+        if let Some(out) = errors.as_deref_mut() {
+            out.row(&c, phase)?;
+        }
+        all.add(&c);
+        if let Some(i) = phase.and_then(|p| Phase::ALL.iter().position(|&a| a == p)) {
+            by_phase[i].add(&c);
+        }
+        let t = c.t_ns as f64 * 1e-9;
+        for (trace, angle) in estimate_traces.iter_mut().zip(c.estimate) {
+            trace.push(t, angle.to_degrees());
+        }
+    }
+    walk.drain(&mut on_read)?;
+    let e = &loaded.truth_extent;
+    Ok(Scored {
+        all,
+        by_phase,
+        traces: Traces {
+            span_s: (e.first_ns as f64 * 1e-9, e.last_ns as f64 * 1e-9),
+            truth: truth_traces.map(|t| t.pieces()),
+            estimate: estimate_traces.map(|t| t.pieces()),
+            phases: runs,
+        },
     })
 }

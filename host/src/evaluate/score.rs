@@ -104,83 +104,127 @@ impl fmt::Display for Span {
     }
 }
 
+/// An instant (ns) and a unit attitude: one sample of a validated series.
+pub(super) type Sample = (u64, UnitQuaternion<f64>);
+
+/// `samples` checked (times strictly increasing, quaternions non-zero and finite) and normalised.
+pub(super) fn validated(
+    samples: &[Stamped],
+    what: &'static str,
+) -> Result<Vec<Sample>, ScoreError> {
+    if samples.is_empty() {
+        return Err(ScoreError::Empty { what });
+    }
+    let mut out = Vec::with_capacity(samples.len());
+    for (index, &(t_ns, raw)) in samples.iter().enumerate() {
+        if index > 0 && t_ns <= samples[index - 1].0 {
+            return Err(ScoreError::NotIncreasing { what, index, t_ns });
+        }
+        let q = normalize(raw).ok_or(ScoreError::BadQuaternion {
+            what,
+            index,
+            q: raw,
+        })?;
+        out.push((t_ns, q));
+    }
+    Ok(out)
+}
+
 /// Validated, time-ordered attitudes with unit quaternions.
 #[derive(Clone, Debug)]
 struct Track {
-    t_ns: Vec<u64>,
-    q: Vec<UnitQuaternion<f64>>,
+    samples: Vec<Sample>,
 }
 
 impl Track {
     fn new(samples: &[Stamped], what: &'static str) -> Result<Self, ScoreError> {
-        if samples.is_empty() {
-            return Err(ScoreError::Empty { what });
-        }
-        let mut q = Vec::with_capacity(samples.len());
-        for (index, &(t_ns, raw)) in samples.iter().enumerate() {
-            if index > 0 && t_ns <= samples[index - 1].0 {
-                return Err(ScoreError::NotIncreasing { what, index, t_ns });
-            }
-            q.push(normalize(raw).ok_or(ScoreError::BadQuaternion {
-                what,
-                index,
-                q: raw,
-            })?);
-        }
         Ok(Self {
-            t_ns: samples.iter().map(|s| s.0).collect(),
-            q,
+            samples: validated(samples, what)?,
         })
+    }
+
+    fn len(&self) -> usize {
+        self.samples.len()
     }
 
     fn span(&self, shift_ns: i64) -> Span {
         Span {
-            start_ns: self.t_ns[0] as i64 - shift_ns,
-            end_ns: *self.t_ns.last().unwrap_or(&0) as i64 - shift_ns,
+            start_ns: self.samples[0].0 as i64 - shift_ns,
+            end_ns: self.samples.last().map_or(0, |s| s.0) as i64 - shift_ns,
         }
     }
-}
 
-/// Where an instant falls in a track.
-struct Located {
-    /// The nearest sample.
-    nearest: usize,
-    /// Whether the instant is that sample's own.
-    exact: bool,
-    /// The attitude there, interpolated.
-    q: UnitQuaternion<f64>,
-}
-
-impl Track {
     fn median_step_ns(&self) -> u64 {
-        let mut steps: Vec<u64> = self.t_ns.windows(2).map(|w| w[1] - w[0]).collect();
+        let mut steps: Vec<u64> = self.samples.windows(2).map(|w| w[1].0 - w[0].0).collect();
         steps.sort_unstable();
         steps.get(steps.len() / 2).copied().unwrap_or(0)
     }
+}
 
-    /// The attitude at `t_ns`, or `None` outside the track or across a gap over `max_gap_ns`.
-    fn at(&self, t_ns: i64, max_gap_ns: u64) -> Option<Located> {
-        let t = &self.t_ns;
-        let after = t.partition_point(|&s| (s as i64) < t_ns);
-        if after < t.len() && t[after] as i64 == t_ns {
-            let q = self.q[after];
-            return Some(Located {
-                nearest: after,
-                exact: true,
-                q,
-            });
-        }
-        if after == 0 || after == t.len() || t[after] - t[after - 1] > max_gap_ns {
-            return None;
-        }
-        let (t0, t1) = (t[after - 1], t[after]);
-        let s = (t_ns - t0 as i64) as f64 / (t1 - t0) as f64;
-        Some(Located {
-            nearest: if s < 0.5 { after - 1 } else { after },
-            exact: false,
-            q: interpolate(&self.q[after - 1], &self.q[after], s),
-        })
+/// Where an instant falls in a series of truth samples.
+pub(super) struct Located {
+    /// The index of the nearest sample.
+    pub(super) nearest: usize,
+    /// Whether the instant is that sample's own.
+    pub(super) exact: bool,
+    /// The attitude there, interpolated.
+    pub(super) q: UnitQuaternion<f64>,
+}
+
+/// The attitude at `t_ns` in consecutive samples `samples` of a series whose first is its
+/// sample number `base`, or `None` outside them or across a gap over `max_gap_ns`. The caller
+/// includes the samples on either side of `t_ns` whenever the series has them.
+pub(super) fn locate(
+    samples: &[Sample],
+    base: usize,
+    t_ns: i64,
+    max_gap_ns: u64,
+) -> Option<Located> {
+    let after = samples.partition_point(|s| (s.0 as i64) < t_ns);
+    if after < samples.len() && samples[after].0 as i64 == t_ns {
+        return Some(Located {
+            nearest: base + after,
+            exact: true,
+            q: samples[after].1,
+        });
     }
+    if after == 0 || after == samples.len() {
+        return None;
+    }
+    let ((t0, q0), (t1, q1)) = (samples[after - 1], samples[after]);
+    if t1 - t0 > max_gap_ns {
+        return None;
+    }
+    let s = (t_ns - t0 as i64) as f64 / (t1 - t0) as f64;
+    Some(Located {
+        nearest: base + if s < 0.5 { after - 1 } else { after },
+        exact: false,
+        q: interpolate(&q0, &q1, s),
+    })
+}
+
+/// The scored comparison of an estimate `(stamp, q, its Euler angles)` with the truth found
+/// at its aligned instant (`truth_euler`: the truth's Euler angles there).
+pub(super) fn compared(
+    located: &Located,
+    truth_euler: [f64; 3],
+    estimate: (u64, &UnitQuaternion<f64>, [f64; 3]),
+    latency_ns: i64,
+) -> Compared {
+    let (stamp, q, e) = estimate;
+    Compared {
+        index: located.nearest,
+        t_ns: (stamp as i64 - latency_ns) as u64,
+        truth: truth_euler,
+        estimate: e,
+        error: [0, 1, 2].map(|i| wrap_angle(truth_euler[i] - e[i])),
+        geodesic: geodesic(&located.q, q),
+    }
+}
+
+/// Whether an estimate's aligned instant is late enough to score (after the warm-up).
+pub(super) fn after_warmup(aligned_ns: i64, first_truth_ns: u64, opts: &ScoreOptions) -> bool {
+    aligned_ns >= first_truth_ns.saturating_add(opts.warmup_ns) as i64
 }
 
 /// The estimates of one run, validated once, with their Euler angles.
@@ -194,18 +238,23 @@ impl Estimates {
     /// Checks `samples` (times strictly increasing, quaternions non-zero and finite).
     pub fn new(samples: &[Stamped]) -> Result<Self, ScoreError> {
         let track = Track::new(samples, "estimate")?;
-        let euler = track.q.iter().map(euler).collect();
+        let euler = track.samples.iter().map(|s| euler(&s.1)).collect();
         Ok(Self { track, euler })
     }
 
     /// Number of estimates.
     pub fn len(&self) -> usize {
-        self.track.t_ns.len()
+        self.track.len()
     }
 
     /// Whether there are none (never: [`Estimates::new`] refuses that).
     pub fn is_empty(&self) -> bool {
-        self.track.t_ns.is_empty()
+        self.track.samples.is_empty()
+    }
+
+    /// The validated samples.
+    pub(super) fn samples(&self) -> &[Sample] {
+        &self.track.samples
     }
 }
 
@@ -239,7 +288,7 @@ impl Reference {
     /// Checks `truth` (times strictly increasing, quaternions non-zero and finite).
     pub fn new(truth: &[Stamped]) -> Result<Self, ScoreError> {
         let track = Track::new(truth, "truth")?;
-        let euler = track.q.iter().map(euler).collect();
+        let euler = track.samples.iter().map(|s| euler(&s.1)).collect();
         let median_step_ns = track.median_step_ns();
         Ok(Self {
             track,
@@ -248,9 +297,9 @@ impl Reference {
         })
     }
 
-    /// Truth instants (ns).
-    pub fn t_ns(&self) -> &[u64] {
-        &self.track.t_ns
+    /// The validated samples.
+    pub(super) fn samples(&self) -> &[Sample] {
+        &self.track.samples
     }
 
     /// Truth Euler angles `[roll, pitch, yaw]` per instant (rad).
@@ -288,53 +337,30 @@ impl Reference {
         Ok(Scores::from_compared(compared.iter()).expect("compare returns at least one"))
     }
 
-    /// Mean squared geodesic error (rad²) over every `stride`-th estimate that is scored, and
-    /// how many it covers; `None` when none is.
-    pub fn geodesic_cost(
-        &self,
-        estimates: &Estimates,
-        opts: &ScoreOptions,
-        stride: usize,
-    ) -> Option<(f64, usize)> {
-        let (mut sum, mut n) = (0.0, 0usize);
-        for j in (0..estimates.len()).step_by(stride.max(1)) {
-            if let Some(truth) = self.truth_at(estimates.track.t_ns[j], opts) {
-                let g = geodesic(&truth.q, &estimates.track.q[j]);
-                sum += g * g;
-                n += 1;
-            }
-        }
-        (n > 0).then(|| (sum / n as f64, n))
-    }
-
     /// The truth at the aligned instant of an estimate stamped `stamp_ns`, if it is scored.
     fn truth_at(&self, stamp_ns: u64, opts: &ScoreOptions) -> Option<Located> {
         let aligned = stamp_ns as i64 - opts.latency_ns;
-        let first = self.track.t_ns[0].saturating_add(opts.warmup_ns);
-        if aligned < first as i64 {
+        if !after_warmup(aligned, self.track.samples[0].0, opts) {
             return None;
         }
         let max_gap = opts.max_gap_ns.unwrap_or(4 * self.median_step_ns);
-        self.track.at(aligned, max_gap)
+        locate(&self.track.samples, 0, aligned, max_gap)
     }
 
     fn compare_at(&self, j: usize, est: &Estimates, opts: &ScoreOptions) -> Option<Compared> {
-        let stamp = est.track.t_ns[j];
-        let located = self.truth_at(stamp, opts)?;
+        let (stamp, q) = &est.track.samples[j];
+        let located = self.truth_at(*stamp, opts)?;
         let truth = if located.exact {
             self.euler[located.nearest]
         } else {
             euler(&located.q)
         };
-        let estimate = est.euler[j];
-        Some(Compared {
-            index: located.nearest,
-            t_ns: (stamp as i64 - opts.latency_ns) as u64,
+        Some(compared(
+            &located,
             truth,
-            estimate,
-            error: [0, 1, 2].map(|i| wrap_angle(truth[i] - estimate[i])),
-            geodesic: geodesic(&located.q, &est.track.q[j]),
-        })
+            (*stamp, q, est.euler[j]),
+            opts.latency_ns,
+        ))
     }
 }
 

@@ -66,10 +66,9 @@ pub fn external_phases(imu: &Imu, rules: &PhaseRules) -> Vec<PhaseSample> {
 
 /// Accelerometer and magnetometer norms of a series.
 pub fn norms(source: &str, t_ns: &[u64], acc: &[[f64; 3]], mag: &[[f64; 3]]) -> Norms {
-    Norms {
-        source: source.to_owned(),
-        t_ns: t_ns.to_vec(),
-        acc: acc.iter().map(norm).collect(),
-        mag: mag.iter().map(norm).collect(),
+    let mut norms = Norms::new(source);
+    for ((&t, a), m) in t_ns.iter().zip(acc).zip(mag) {
+        norms.push(t, a, m);
     }
+    norms
 }

@@ -32,37 +32,63 @@ pub struct Scores {
 
 impl Scores {
     /// The scores of a set of compared instants; `None` when it is empty.
-    pub fn from_compared<'a>(compared: impl Iterator<Item = &'a Compared> + Clone) -> Option<Self> {
-        let n = compared.clone().count();
-        if n == 0 {
+    pub fn from_compared<'a>(compared: impl Iterator<Item = &'a Compared>) -> Option<Self> {
+        let mut acc = Accumulator::default();
+        compared.for_each(|c| acc.add(c));
+        acc.scores()
+    }
+}
+
+/// Scores gathered one compared instant at a time, in constant memory: sums for the means
+/// (`mean`, `MSE`, the geodesic RMS, in the order the instants come), Welford's update for the
+/// spread about the mean (`STD`, equal to the two-pass `√(Σ(e − mean)²/N)` to within rounding).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Accumulator {
+    n: usize,
+    sum: [f64; 3],
+    sum_sq: [f64; 3],
+    welford_mean: [f64; 3],
+    welford_m2: [f64; 3],
+    max_abs: [f64; 3],
+    geodesic_sq: f64,
+    geodesic_max: f64,
+}
+
+impl Accumulator {
+    /// Adds one compared instant.
+    pub fn add(&mut self, c: &Compared) {
+        self.n += 1;
+        let n = self.n as f64;
+        for (i, &e) in c.error.iter().enumerate() {
+            self.sum[i] += e;
+            self.sum_sq[i] += e * e;
+            let delta = e - self.welford_mean[i];
+            self.welford_mean[i] += delta / n;
+            self.welford_m2[i] += delta * (e - self.welford_mean[i]);
+            self.max_abs[i] = self.max_abs[i].max(e.abs());
+        }
+        self.geodesic_sq += c.geodesic * c.geodesic;
+        self.geodesic_max = self.geodesic_max.max(c.geodesic);
+    }
+
+    /// The scores so far; `None` before the first instant.
+    pub fn scores(&self) -> Option<Scores> {
+        if self.n == 0 {
             return None;
         }
-        let nf = n as f64;
-        let angles = [0, 1, 2].map(|i| {
-            let mean = compared.clone().map(|c| c.error[i]).sum::<f64>() / nf;
-            let mse = compared.clone().map(|c| c.error[i].powi(2)).sum::<f64>() / nf;
-            let var = compared
-                .clone()
-                .map(|c| (c.error[i] - mean).powi(2))
-                .sum::<f64>()
-                / nf;
-            let max_abs = compared
-                .clone()
-                .fold(0.0f64, |m, c| m.max(c.error[i].abs()));
-            AngleStats {
-                mean,
-                mse,
-                std: var.sqrt(),
-                max_abs,
-            }
+        let nf = self.n as f64;
+        let angles = [0, 1, 2].map(|i| AngleStats {
+            mean: self.sum[i] / nf,
+            mse: self.sum_sq[i] / nf,
+            std: (self.welford_m2[i] / nf).sqrt(),
+            max_abs: self.max_abs[i],
         });
-        let g2 = compared.clone().map(|c| c.geodesic.powi(2)).sum::<f64>() / nf;
-        Some(Self {
-            count: n,
+        Some(Scores {
+            count: self.n,
             angles,
             f: (angles[0].mse * angles[1].mse * angles[2].mse).cbrt(),
-            geodesic_rms: g2.sqrt(),
-            geodesic_max: compared.fold(0.0f64, |m, c| m.max(c.geodesic)),
+            geodesic_rms: (self.geodesic_sq / nf).sqrt(),
+            geodesic_max: self.geodesic_max,
         })
     }
 }

@@ -15,7 +15,7 @@
 //! magnetometer only, not the gyroscope a filter needs.
 
 use crate::csv_column::ColumnError;
-use crate::evaluate::input::{read_truth, read_vectors, Imu};
+use crate::evaluate::input::{read_first_attitude, seconds, Imu, VectorRows};
 use crate::scene::Scene;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -64,63 +64,106 @@ fn bad(path: &Path, reason: impl Into<String>) -> InputError {
     }
 }
 
-/// Reads a run directory or an external CSV recording (see the module docs). `mag_reference`
-/// replaces the reference a run directory's scene gives, and is the one an external recording
-/// uses (default `(0.5, 0, −0.83)`).
-pub fn read(path: &Path, mag_reference: Option<[f64; 3]>) -> Result<Recording, InputError> {
-    if path.is_dir() {
-        let marg = path.join("marg.csv");
-        if marg.is_file() {
-            return read_run(path, &marg, mag_reference);
-        }
-        if path.join("sent.csv").is_file() {
-            return Err(bad(
-                path,
-                "a session directory: filtering sessions is not supported yet (sent.csv's \
-                 images are decoded without the gyroscope); filter the simulate run of its \
-                 scene instead",
-            ));
-        }
-        return Err(bad(
-            path,
-            "no marg.csv here (expected a `simulate` run directory)",
-        ));
-    }
-    if !path.exists() {
-        return Err(bad(path, "no such file or directory"));
-    }
-    read_external(path, mag_reference.unwrap_or(DEFAULT_MAG_REFERENCE))
+/// One IMU sample: instant (ns), specific force, angular rate, field.
+pub type Sample = (u64, [f64; 3], [f64; 3], [f64; 3]);
+
+/// A recording being read one sample at a time (see the module docs): memory does not grow with
+/// its length.
+pub struct Samples {
+    rows: Rows,
+    /// World-frame magnetic reference (any length; only its direction is used).
+    pub mag_reference: [f64; 3],
+    /// What is read, for messages.
+    pub source: String,
 }
 
-fn read_run(
-    dir: &Path,
-    marg: &Path,
-    mag_reference: Option<[f64; 3]>,
-) -> Result<Recording, InputError> {
-    let (t_ns, [acc, gyr, mag]) = read_vectors(
-        marg,
-        [
-            ["acc_x", "acc_y", "acc_z"],
-            ["gyr_x", "gyr_y", "gyr_z"],
-            ["mag_x", "mag_y", "mag_z"],
-        ],
-    )?;
-    if t_ns.is_empty() {
-        return Err(bad(marg, "no samples"));
-    }
-    let mag_reference = match mag_reference {
-        Some(r) => r,
-        None => scene_field(&dir.join("meta.toml"))?,
+enum Rows {
+    Run(VectorRows<3>),
+    External(External),
+}
+
+/// Opens a run directory or an external CSV recording (see the module docs) and checks that it
+/// has a first sample. `mag_reference` replaces the reference a run directory's scene gives,
+/// and is the one an external recording uses (default `(0.5, 0, −0.83)`).
+pub fn open(path: &Path, mag_reference: Option<[f64; 3]>) -> Result<Samples, InputError> {
+    let (rows, reference, source) = if path.is_dir() {
+        let marg = path.join("marg.csv");
+        if !marg.is_file() {
+            if path.join("sent.csv").is_file() {
+                return Err(bad(
+                    path,
+                    "a session directory: filtering sessions is not supported yet (sent.csv's \
+                     images are decoded without the gyroscope); filter the simulate run of its \
+                     scene instead",
+                ));
+            }
+            return Err(bad(
+                path,
+                "no marg.csv here (expected a `simulate` run directory)",
+            ));
+        }
+        let rows = VectorRows::open(
+            &marg,
+            [
+                ["acc_x", "acc_y", "acc_z"],
+                ["gyr_x", "gyr_y", "gyr_z"],
+                ["mag_x", "mag_y", "mag_z"],
+            ],
+        )?;
+        let reference = match mag_reference {
+            Some(r) => r,
+            None => scene_field(&path.join("meta.toml"))?,
+        };
+        (Rows::Run(rows), reference, marg)
+    } else if !path.exists() {
+        return Err(bad(path, "no such file or directory"));
+    } else {
+        let reference = mag_reference.unwrap_or(DEFAULT_MAG_REFERENCE);
+        (
+            Rows::External(External::open(path)?),
+            reference,
+            path.to_path_buf(),
+        )
     };
+    Ok(Samples {
+        rows,
+        mag_reference: reference,
+        source: source.display().to_string(),
+    })
+}
+
+impl Samples {
+    /// The next sample, or `None` at the end.
+    pub fn next_sample(&mut self) -> Result<Option<Sample>, InputError> {
+        match &mut self.rows {
+            Rows::Run(rows) => Ok(rows.next()?.map(|(t, [a, g, m])| (t, a, g, m))),
+            Rows::External(rows) => rows.next(),
+        }
+    }
+
+    /// The first sample: an error when there is none.
+    pub fn first_sample(&mut self) -> Result<Sample, InputError> {
+        self.next_sample()?
+            .ok_or_else(|| bad(Path::new(&self.source), "no samples"))
+    }
+}
+
+/// Reads a run directory or an external CSV recording into memory (see [`open`]).
+pub fn read(path: &Path, mag_reference: Option<[f64; 3]>) -> Result<Recording, InputError> {
+    let mut samples = open(path, mag_reference)?;
+    let mut imu = Imu::default();
+    let mut next = Some(samples.first_sample()?);
+    while let Some((t, a, g, m)) = next {
+        imu.t_ns.push(t);
+        imu.acc.push(a);
+        imu.gyr.push(g);
+        imu.mag.push(m);
+        next = samples.next_sample()?;
+    }
     Ok(Recording {
-        imu: Imu {
-            t_ns,
-            acc,
-            gyr,
-            mag,
-        },
-        mag_reference,
-        source: marg.display().to_string(),
+        imu,
+        mag_reference: samples.mag_reference,
+        source: samples.source,
     })
 }
 
@@ -133,12 +176,10 @@ pub fn first_true_attitude(dir: &Path) -> Result<[f64; 4], InputError> {
             "starting from the truth needs a run directory with truth.csv",
         ));
     }
-    let truth = read_truth(&dir.join("truth.csv"))?;
-    truth
-        .attitude
-        .first()
+    let path = dir.join("truth.csv");
+    read_first_attitude(&path)?
         .map(|s| s.1)
-        .ok_or_else(|| bad(&dir.join("truth.csv"), "no samples"))
+        .ok_or_else(|| bad(&path, "no samples"))
 }
 
 /// The `[field] reference` of the scene text in a run's `meta.toml`.
@@ -173,33 +214,64 @@ struct Row {
     mz: f64,
 }
 
-fn read_external(path: &Path, mag_reference: [f64; 3]) -> Result<Recording, InputError> {
-    let file = std::fs::File::open(path).map_err(|e| bad(path, format!("cannot read: {e}")))?;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(std::io::BufReader::new(file));
-    let read_err = |cause| ColumnError::Read {
-        path: path.to_path_buf(),
-        cause,
-    };
-    let header = reader.headers().map_err(read_err)?.clone();
-    if let Some(missing) = COLUMNS.iter().find(|c| !header.iter().any(|h| h == **c)) {
-        let found = header.iter().collect::<Vec<_>>().join(", ");
-        return Err(bad(
-            path,
-            format!("no column `{missing}` in the header (columns: {found})"),
-        ));
-    }
-    let mut imu = Imu::default();
-    let mut record = csv::StringRecord::new();
-    while reader.read_record(&mut record).map_err(read_err)? {
-        let line = record.position().map_or(0, |p| p.line());
-        let at = |reason: String| InputError::Row {
+/// An external recording being read.
+struct External {
+    path: PathBuf,
+    reader: csv::Reader<std::io::BufReader<std::fs::File>>,
+    header: csv::StringRecord,
+    record: csv::StringRecord,
+    last: Option<u64>,
+}
+
+impl External {
+    fn open(path: &Path) -> Result<Self, InputError> {
+        let file = std::fs::File::open(path).map_err(|e| bad(path, format!("cannot read: {e}")))?;
+        let mut reader = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_reader(std::io::BufReader::new(file));
+        let header = reader
+            .headers()
+            .map_err(|cause| ColumnError::Read {
+                path: path.to_path_buf(),
+                cause,
+            })?
+            .clone();
+        if let Some(missing) = COLUMNS.iter().find(|c| !header.iter().any(|h| h == **c)) {
+            let found = header.iter().collect::<Vec<_>>().join(", ");
+            return Err(bad(
+                path,
+                format!("no column `{missing}` in the header (columns: {found})"),
+            ));
+        }
+        Ok(Self {
             path: path.to_path_buf(),
+            reader,
+            header,
+            record: csv::StringRecord::new(),
+            last: None,
+        })
+    }
+
+    fn next(&mut self) -> Result<Option<Sample>, InputError> {
+        let path = &self.path;
+        let more =
+            self.reader
+                .read_record(&mut self.record)
+                .map_err(|cause| ColumnError::Read {
+                    path: path.clone(),
+                    cause,
+                })?;
+        if !more {
+            return Ok(None);
+        }
+        let line = self.record.position().map_or(0, |p| p.line());
+        let at = |reason: String| InputError::Row {
+            path: path.clone(),
             line,
             reason,
         };
-        let row: Row = record.deserialize(Some(&header)).map_err(|e| {
+        let header = &self.header;
+        let row: Row = self.record.deserialize(Some(header)).map_err(|e| {
             at(match e.kind() {
                 csv::ErrorKind::Deserialize { err, .. } => {
                     let column = err
@@ -222,26 +294,21 @@ fn read_external(path: &Path, mag_reference: [f64; 3]) -> Result<Recording, Inpu
             return Err(at(format!("`t_s` = {} is outside 0 to 1.8e10 s", row.t_s)));
         }
         let t_ns = (row.t_s * 1e9).round() as u64;
-        if let Some(&last) = imu.t_ns.last() {
+        if let Some(last) = self.last {
             if t_ns <= last {
                 return Err(at(format!(
                     "`t_s` = {} does not increase (previous row: {})",
                     row.t_s,
-                    last as f64 * 1e-9
+                    seconds(last)
                 )));
             }
         }
-        imu.t_ns.push(t_ns);
-        imu.acc.push([row.ax, row.ay, row.az]);
-        imu.gyr.push([row.gx, row.gy, row.gz]);
-        imu.mag.push([row.mx, row.my, row.mz]);
+        self.last = Some(t_ns);
+        Ok(Some((
+            t_ns,
+            [row.ax, row.ay, row.az],
+            [row.gx, row.gy, row.gz],
+            [row.mx, row.my, row.mz],
+        )))
     }
-    if imu.t_ns.is_empty() {
-        return Err(bad(path, "no samples"));
-    }
-    Ok(Recording {
-        imu,
-        mag_reference,
-        source: path.display().to_string(),
-    })
 }

@@ -6,6 +6,8 @@
 //! - [`input`]: a `simulate` run directory or an external CSV recording, read into samples;
 //! - [`run`]: the filter over the samples, one estimate per sample stamped with its instant
 //!   (the filter's `dt` from the stamps, through `evaluate::estimate_with`), in `f64`;
+//! - [`filter_to_file`]: the filter from a recording on disk to an estimates file, one sample
+//!   at a time (memory bounded; warnings for all-zero accelerometer or magnetometer data);
 //! - [`write_estimates`]: `t_s,qw,qx,qy,qz,roll,pitch,yaw` (s from the recording's start of
 //!   time, the quaternion body to world, ZYX Euler angles in rad), which `margemu evaluate
 //!   RUN --estimates FILE` scores.
@@ -29,11 +31,13 @@
 //! # Ok::<(), margemu::offline::ParamError>(())
 //! ```
 
+mod file;
 pub mod input;
 pub mod params;
 mod params_file;
 
-pub use input::{first_true_attitude, read, InputError, Recording};
+pub use file::{filter_to_file, FilterError, FilterRun};
+pub use input::{first_true_attitude, open, read, InputError, Recording, Samples};
 pub use margemu_filters::Initial;
 pub use params::{FilterKind, FilterParams, ParamError, ParamSpec};
 
@@ -108,13 +112,23 @@ pub fn write_estimates(out: &mut impl Write, estimates: &[Stamped]) -> io::Resul
     writeln!(out, "{}", ESTIMATE_COLUMNS.join(","))?;
     let mut float = ryu::Buffer::new();
     for &(t_ns, q) in estimates {
-        let (s, ns) = (t_ns / 1_000_000_000, t_ns % 1_000_000_000);
-        write!(out, "{s}.{ns:09}")?;
-        for v in q.iter().chain(&euler_zyx(q)) {
-            out.write_all(b",")?;
-            out.write_all(float.format(*v).as_bytes())?;
-        }
-        out.write_all(b"\n")?;
+        write_estimate(out, &mut float, t_ns, q)?;
     }
     out.flush()
+}
+
+/// One row of the estimates file.
+fn write_estimate(
+    out: &mut impl Write,
+    float: &mut ryu::Buffer,
+    t_ns: u64,
+    q: [f64; 4],
+) -> io::Result<()> {
+    let (s, ns) = (t_ns / 1_000_000_000, t_ns % 1_000_000_000);
+    write!(out, "{s}.{ns:09}")?;
+    for v in q.iter().chain(&euler_zyx(q)) {
+        out.write_all(b",")?;
+        out.write_all(float.format(*v).as_bytes())?;
+    }
+    out.write_all(b"\n")
 }

@@ -152,17 +152,19 @@ pub fn image_settings(scene: &Scene) -> Result<ImageSettings, board::NoBoard> {
 /// initial heading, 26° in the tests' gentle scene) dominates: it drags the estimate to a
 /// latency that trades roll and pitch error for yaw error (−114 ms seen, with 5° of roll
 /// error instead of 0.3°). The flight controller stamps each output with its sample's instant
-/// on the device clock, so its latency on that clock is 0 by construction.
+/// on the device clock, so its latency on that clock is 0 by construction. Writes
+/// `dir/errors.csv`.
 pub fn evaluate_session(
     dir: &std::path::Path,
 ) -> Result<crate::evaluate::Evaluation, crate::evaluate::EvalError> {
-    use crate::evaluate::{evaluate, EvalOptions, LatencyMode, Source};
+    use crate::evaluate::{evaluate_writing, EvalOptions, LatencyMode, Source};
     let options = EvalOptions {
         message: Some("ATTITUDE_QUATERNION".into()),
         latency: (!session_has_magnetometer(dir)).then_some(LatencyMode::Fixed(0)),
         ..EvalOptions::default()
     };
-    evaluate(&Source::Session(dir.to_path_buf()), &options)
+    let errors = dir.join("errors.csv");
+    evaluate_writing(&Source::Session(dir.to_path_buf()), &options, Some(&errors))
 }
 
 /// Whether the chip of the session in `dir` has a magnetometer, by `meta.toml`'s `[chip]
