@@ -2,13 +2,14 @@
 //! for a bad value the line and the column (errors are [`ColumnError`]s, as for single columns).
 
 use crate::csv_column::ColumnError;
+use crate::input_file::{open_stream, LineBounded};
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
 /// An open CSV file and its header.
 pub(crate) struct Table {
     path: PathBuf,
-    reader: csv::Reader<File>,
+    reader: csv::Reader<LineBounded<File>>,
     header: csv::StringRecord,
     record: csv::StringRecord,
 }
@@ -20,10 +21,10 @@ impl Table {
             path: path.to_path_buf(),
             cause,
         };
+        let file = open_stream(path).map_err(ColumnError::Input)?;
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
-            .from_path(path)
-            .map_err(read_err)?;
+            .from_reader(file);
         let header = reader.headers().map_err(read_err)?.clone();
         Ok(Self {
             path: path.to_path_buf(),

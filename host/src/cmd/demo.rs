@@ -43,8 +43,7 @@ pub struct Cmd {
 
 /// Tuned parameters from a file: each filter's table must be there.
 fn from_file(path: &Path) -> Result<Box<demo::Tuned<'static>>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text = margemu::input_file::read_to_string(path)?;
     let tables: toml::Table = text
         .parse()
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;

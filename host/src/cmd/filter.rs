@@ -38,8 +38,7 @@ impl Cmd {
     pub fn run(self) -> Result<()> {
         let mut params = match &self.params {
             Some(path) => {
-                let text = std::fs::read_to_string(path)
-                    .with_context(|| format!("{}: cannot read", path.display()))?;
+                let text = margemu::input_file::read_to_string(path)?;
                 FilterParams::from_toml(&text, path, self.filter)?
             }
             None => FilterParams::defaults(self.filter),

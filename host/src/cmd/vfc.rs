@@ -35,8 +35,7 @@ impl VfcArgs {
         };
         let filter = match &self.vfc_params {
             Some(path) => {
-                let text = std::fs::read_to_string(path)
-                    .with_context(|| format!("reading {}", path.display()))?;
+                let text = margemu::input_file::read_to_string(path)?;
                 FilterParams::from_toml(&text, path, kind)?
             }
             None => FilterParams::defaults(kind),

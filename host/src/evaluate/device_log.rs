@@ -85,7 +85,7 @@ fn bad(path: &Path, reason: impl Into<String>) -> SessionFileError {
 /// Reads `dir/meta.toml` (and `dir/events.csv` when `meta.toml` has no `start_host_ns`).
 pub fn read_meta(dir: &Path) -> Result<SessionMeta, SessionFileError> {
     let path = dir.join("meta.toml");
-    let text = std::fs::read_to_string(&path).map_err(|e| bad(&path, e.to_string()))?;
+    let text = crate::input_file::read_to_string(&path).map_err(|e| bad(&path, e.reason()))?;
     let meta: MetaFile = toml::from_str(&text).map_err(|e| bad(&path, e.to_string()))?;
     let start_host_ns = match meta.start_host_ns {
         Some(ns) => ns,

@@ -188,8 +188,8 @@ fn scene_field(meta: &Path) -> Result<[f64; 3], InputError> {
     struct Meta {
         scene_text: String,
     }
-    let text = std::fs::read_to_string(meta)
-        .map_err(|e| bad(meta, format!("cannot read ({e}); pass --mag-reference")))?;
+    let text = crate::input_file::read_to_string(meta)
+        .map_err(|e| bad(meta, format!("{}; pass --mag-reference", e.reason())))?;
     let m: Meta = toml::from_str(&text).map_err(|e| bad(meta, e.message().trim().to_owned()))?;
     let scene = Scene::parse_str(&m.scene_text, &meta.join("scene_text"))
         .map_err(|e| bad(meta, format!("its scene text is not a valid scene: {e}")))?;
@@ -217,7 +217,7 @@ struct Row {
 /// An external recording being read.
 struct External {
     path: PathBuf,
-    reader: csv::Reader<std::io::BufReader<std::fs::File>>,
+    reader: csv::Reader<crate::input_file::LineBounded<std::fs::File>>,
     header: csv::StringRecord,
     record: csv::StringRecord,
     last: Option<u64>,
@@ -225,10 +225,10 @@ struct External {
 
 impl External {
     fn open(path: &Path) -> Result<Self, InputError> {
-        let file = std::fs::File::open(path).map_err(|e| bad(path, format!("cannot read: {e}")))?;
+        let file = crate::input_file::open_stream(path).map_err(ColumnError::Input)?;
         let mut reader = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
-            .from_reader(std::io::BufReader::new(file));
+            .from_reader(file);
         let header = reader
             .headers()
             .map_err(|cause| ColumnError::Read {

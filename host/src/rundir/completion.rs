@@ -96,9 +96,9 @@ pub fn read_completion(dir: &Path) -> Result<Option<Completion>, RunDirError> {
 
 fn read_head(dir: &Path) -> Result<MetaHead, RunDirError> {
     let path = dir.join(META_FILE);
-    let text = std::fs::read_to_string(&path).map_err(|source| RunDirError::Io {
+    let text = crate::input_file::read_to_string(&path).map_err(|e| RunDirError::BadMeta {
         path: path.clone(),
-        source,
+        reason: e.reason(),
     })?;
     toml::from_str(&text).map_err(|e| RunDirError::BadMeta {
         path,

@@ -170,7 +170,7 @@ pub fn evaluate_session(
 /// Whether the chip of the session in `dir` has a magnetometer, by `meta.toml`'s `[chip]
 /// model`; `true` when that cannot be read (the MPU-9250, the default chip, has one).
 pub fn session_has_magnetometer(dir: &std::path::Path) -> bool {
-    let model = std::fs::read_to_string(dir.join("meta.toml"))
+    let model = crate::input_file::read_to_string(&dir.join("meta.toml"))
         .ok()
         .and_then(|text| text.parse::<toml::Table>().ok())
         .and_then(|meta| {
