@@ -97,6 +97,20 @@ fn sigterm_ends_a_simulation_with_its_record() {
         .count() as u64;
     assert_eq!(rows, record.samples_written + 1);
     assert!(!partial.exists());
+    // `filter` does not take the interrupted run for a whole one either.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_margemu"))
+        .args(["filter", "--filter", "ecf"])
+        .arg(&dir)
+        .arg("-o")
+        .arg(work.join("estimates.csv"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("holds an incomplete run: meta.toml's completion record says interrupted"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -102,6 +102,14 @@ pub fn open(path: &Path, mag_reference: Option<[f64; 3]>) -> Result<Samples, Inp
                 "no marg.csv here (expected a `simulate` run directory)",
             ));
         }
+        // A run that was killed, interrupted or failed is not filtered as if it were whole.
+        match crate::rundir::check_complete(path, false) {
+            Ok(_) => {}
+            Err(crate::rundir::RunDirError::Incomplete { why, .. }) => {
+                return Err(bad(path, format!("holds an incomplete run: {why}")));
+            }
+            Err(e) => return Err(bad(path, e.to_string())),
+        }
         let rows = VectorRows::open(
             &marg,
             [
