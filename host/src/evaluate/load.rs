@@ -128,13 +128,7 @@ fn scan_truth(
         let specific_force = row.f64s(f_cols)?;
         let accel = row.f64s(a_cols)?;
         let field = row.f64s(m_cols)?;
-        let e = extent.get_or_insert(Extent {
-            count: 0,
-            first_ns: t,
-            last_ns: t,
-        });
-        e.count += 1;
-        e.last_ns = t;
+        Extent::add(&mut extent, t);
         median.add(t);
         let disturbance = match &mut perturbation {
             Some(p) => p.at(t)?.map_or([0.0; 3], |[d]| d),

@@ -34,6 +34,17 @@ pub(super) struct Extent {
 }
 
 impl Extent {
+    /// Counts one more sample at `t_ns` (in time order) into `extent`, starting it if empty.
+    pub(super) fn add(extent: &mut Option<Extent>, t_ns: u64) {
+        let e = extent.get_or_insert(Extent {
+            count: 0,
+            first_ns: t_ns,
+            last_ns: t_ns,
+        });
+        e.count += 1;
+        e.last_ns = t_ns;
+    }
+
     /// The span, shifted back by `shift_ns`.
     pub(super) fn span(&self, shift_ns: i64) -> Span {
         Span {
@@ -74,14 +85,7 @@ impl Series {
     pub(super) fn extent(&self) -> Result<Option<Extent>, EvalError> {
         let mut extent: Option<Extent> = None;
         for sample in self.read()? {
-            let t = sample?.0;
-            let e = extent.get_or_insert(Extent {
-                count: 0,
-                first_ns: t,
-                last_ns: t,
-            });
-            e.count += 1;
-            e.last_ns = t;
+            Extent::add(&mut extent, sample?.0);
         }
         Ok(extent)
     }
