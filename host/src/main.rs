@@ -14,6 +14,13 @@ struct Cli {
 }
 
 fn main() -> std::process::ExitCode {
+    // Rust ignores SIGPIPE, so printing to a closed pipe (`margemu scene check S | head -1`)
+    // would panic in `println!`; a command-line tool ends quietly instead, as `cat` does.
+    // SAFETY: called first in `main`, before any thread exists; SIG_DFL is a valid handler.
+    #[allow(unsafe_code)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     match cli.command.run() {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -185,3 +185,22 @@ fn chips_lists_every_model_with_its_facts() {
         "{err}"
     );
 }
+
+/// Output into a pipe nobody reads (`margemu … | head` after head has quit) ends the process
+/// by SIGPIPE, as for any command-line tool, instead of a panic in `println!`.
+#[test]
+fn output_into_a_closed_pipe_ends_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
+        .args(["scene", "check", &fixture("case-study.toml")])
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    const SIGPIPE: i32 = 13; // Linux
+    assert_eq!(out.status.signal(), Some(SIGPIPE), "{:?}", out.status);
+}
