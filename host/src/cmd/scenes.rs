@@ -24,7 +24,8 @@ impl Cmd {
             .map(|name| builtin::load(name))
             .collect::<Result<Vec<_>, _>>()?;
         let rows: Vec<[String; 6]> = scenes.iter().map(row).collect();
-        let header = ["name", "duration", "rate", "motion", "chip", "description"].map(String::from);
+        let header =
+            ["name", "duration", "rate", "motion", "chip", "description"].map(String::from);
         let mut widths = [0; 5];
         for r in std::iter::once(&header).chain(&rows) {
             for (w, cell) in widths.iter_mut().zip(r) {

@@ -183,7 +183,9 @@ mod tests {
             e,
             format!("scenes/figure3.toml: no such file (built-in scenes, by name: {list})")
         );
-        let e = resolve(Path::new("builtin:figure4")).unwrap_err().to_string();
+        let e = resolve(Path::new("builtin:figure4"))
+            .unwrap_err()
+            .to_string();
         assert_eq!(
             e,
             format!("builtin:figure4: no built-in scene has that name (built-in scenes: {list})")
