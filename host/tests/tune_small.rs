@@ -185,7 +185,10 @@ fn cli_prints_the_table_and_writes_parameters_filter_takes() {
         "{e}"
     );
     let e = failed(&margemu(&["tune", "missing.toml", "--filter", "ekf"]));
-    assert!(e.contains("missing.toml: cannot read"), "{e}");
+    assert!(
+        e.contains("missing.toml: no such file (built-in scenes, by name: "),
+        "{e}"
+    );
     std::fs::write(&params, "[gda\n").unwrap();
     let e = failed(&margemu(&[
         "tune",

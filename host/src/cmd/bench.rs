@@ -2,12 +2,10 @@
 
 use anyhow::Result;
 use margemu::perf::{integrator_sweep, mode_costs};
-use margemu::scene::{Method, MotionMode, Scene};
+use margemu::scene::{builtin, Method, MotionMode, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-const FIGURE3: &str = include_str!("../../../hil-fixtures/scenes/figure3.toml");
-const STATIC: &str = include_str!("../../../hil-fixtures/scenes/static.toml");
 const KINEMATIC: &str = "name = \"figure3-kinematic\"\nduration = 3.0\nrate = 1000.0\nseed = 1\n\
 motion = \"kinematic\"\n[bench]\ninitial = [1.0, 1.0, 1.0, 0.0, 0.0, 0.0]\n\
 [joints.x]\ntype = \"sine\"\namplitude = 0.3\nfrequency = 1.0\noffset = 1.0\n\
@@ -38,7 +36,7 @@ pub enum Cmd {
     Stream(super::bench_stream::Cmd),
 }
 
-fn builtin(text: &str, name: &str) -> Result<Scene> {
+fn inline(text: &str, name: &str) -> Result<Scene> {
     Ok(Scene::parse_str(text, Path::new(name))?)
 }
 
@@ -48,7 +46,7 @@ impl Cmd {
             Cmd::Integrators { scene, seconds } => {
                 let scene = match scene {
                     Some(p) => super::load_scene(&p)?,
-                    None => builtin(FIGURE3, "figure3.toml (built in)")?,
+                    None => builtin::load("figure3")?,
                 };
                 if scene.spec.motion != MotionMode::Bench {
                     anyhow::bail!(
@@ -98,13 +96,15 @@ impl Cmd {
             Cmd::Stream(cmd) => cmd.run()?,
             Cmd::Modes { seconds } => {
                 let scenes = [
-                    builtin(STATIC, "static.toml (built in, 200 Hz)")?,
-                    builtin(
-                        &STATIC.replace("rate = 200.0", "rate = 1000.0"),
-                        "static.toml at 1 kHz",
+                    builtin::load("static")?,
+                    inline(
+                        &builtin::get("static")
+                            .expect("built in")
+                            .replace("rate = 200.0", "rate = 1000.0"),
+                        "builtin:static at 1 kHz",
                     )?,
-                    builtin(KINEMATIC, "kinematic sines")?,
-                    builtin(FIGURE3, "figure3.toml (built in)")?,
+                    inline(KINEMATIC, "kinematic sines")?,
+                    builtin::load("figure3")?,
                 ];
                 println!(
                     "| scene | mode | output rate (Hz) | ns per sample | simulated s / wall s |"

@@ -13,8 +13,9 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Cmd {
-    /// The scene (default: the paper's case study).
-    #[arg(long, default_value = "hil-fixtures/scenes/case-study.toml")]
+    /// The scene: a file (TOML) or a built-in scene's name (`margemu scenes`); default: the
+    /// paper's case study.
+    #[arg(long, default_value = "case-study")]
     scene: PathBuf,
     // One session per run (`<filter>-<initial|tuned>/`, with report.md and figures) and
     // table3.md; default: demo/, numbered if taken.

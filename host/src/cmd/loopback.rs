@@ -1,4 +1,4 @@
-//! `margemu loopback SCENE [-o DIR]`: the embedded default. The firmware's link handler runs on
+//! `margemu loopback [SCENE] [-o DIR]`: the embedded default. The firmware's link handler runs on
 //! the host behind a real pseudo-terminal pair, the scene streams to it exactly as to a board,
 //! and every image the device reports serving is checked against the host's prediction. With
 //! `--dut PORT` a device under test's output is logged beside the session; with `--vfc FILTER`
@@ -14,7 +14,8 @@ use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct Cmd {
-    /// The scene file (TOML).
+    /// The scene: a file (TOML) or a built-in scene's name (`margemu scenes`).
+    #[arg(default_value = "figure3")]
     scene: PathBuf,
     // Default: sessions/<scene name>-loopback.
     #[command(flatten)]
@@ -42,7 +43,7 @@ impl Cmd {
             None => ImageSettings::for_scene(&scene),
         };
         let (host_end, device_end) = TTYPort::pair().context("opening a pseudo-terminal pair")?;
-        let dir = self.output.prepare(&self.scene, "sessions", "-loopback")?;
+        let dir = self.output.prepare(&scene, "sessions", "-loopback")?;
         let label = device_end
             .name()
             .unwrap_or_else(|| "a pseudo-terminal".into());

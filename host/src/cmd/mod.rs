@@ -15,6 +15,7 @@ pub mod filter;
 pub mod loopback;
 pub mod ports;
 pub mod scene;
+pub mod scenes;
 pub mod simulate;
 pub mod stream;
 pub mod tune;
@@ -34,10 +35,15 @@ pub struct OutputArgs {
 }
 
 impl OutputArgs {
-    /// The directory, created and empty: --output, or `<parent>/<scene stem><suffix>` made
-    /// fresh.
-    pub fn prepare(&self, scene: &Path, parent: &str, suffix: &str) -> Result<PathBuf> {
-        let stem = scene.file_stem().unwrap_or_default().to_string_lossy();
+    /// The directory, created and empty: --output, or `<parent>/<scene's stem><suffix>` made
+    /// fresh (the stem: a built-in scene's name, or the file's name without its extension).
+    pub fn prepare(
+        &self,
+        scene: &margemu::scene::Scene,
+        parent: &str,
+        suffix: &str,
+    ) -> Result<PathBuf> {
+        let stem = scene.stem();
         self.prepare_or(&Path::new(parent).join(format!("{stem}{suffix}")))
     }
 
@@ -102,8 +108,11 @@ pub enum Command {
     /// Inspect scene files.
     #[command(subcommand)]
     Scene(scene::Cmd),
-    /// Stream a scene to the firmware's link handler behind a pseudo-terminal pair (no hardware);
-    /// the session goes to sessions/<scene name>-loopback (numbered if taken) unless -o.
+    /// List the built-in scenes (a command takes one by name wherever it takes a scene file).
+    Scenes(scenes::Cmd),
+    /// Stream a scene (default: the built-in figure3) to the firmware's link handler behind a
+    /// pseudo-terminal pair (no hardware); the session goes to sessions/<scene name>-loopback
+    /// (numbered if taken) unless -o.
     Loopback(loopback::Cmd),
     /// Simulate a scene and write its run directory (truth.csv, marg.csv, meta.toml) to
     /// runs/<scene name> (numbered if taken) unless -o.
@@ -132,11 +141,12 @@ pub enum Command {
     Tune(tune::Cmd),
 }
 
-/// Loads a scene file for a command, reads and checks its CSV joint sources (so a bad source
-/// stops the command before it writes anything), and prints the scene's warnings to stderr:
-/// the one place commands load scenes, so the warnings appear once per command.
-pub fn load_scene(path: &std::path::Path) -> anyhow::Result<margemu::scene::Scene> {
-    let scene = margemu::scene::Scene::load(path)?;
+/// Loads the scene a command's argument stands for (a file's path, or a built-in scene's name:
+/// [`margemu::scene::builtin::resolve`]), reads and checks its CSV joint sources (so a bad
+/// source stops the command before it writes anything), and prints the scene's warnings to
+/// stderr: the one place commands load scenes, so the warnings appear once per command.
+pub fn load_scene(arg: &std::path::Path) -> anyhow::Result<margemu::scene::Scene> {
+    let scene = margemu::scene::builtin::resolve(arg)?;
     for warning in &scene.warnings {
         eprintln!("warning: {warning}");
     }
@@ -164,6 +174,7 @@ impl Command {
     pub fn run(self) -> anyhow::Result<()> {
         match self {
             Command::Scene(c) => c.run(),
+            Command::Scenes(c) => c.run(),
             Command::Simulate(c) => c.run(),
             Command::Loopback(c) => c.run(),
             Command::Bench(c) => c.run(),

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 pub enum Cmd {
     /// Validate a scene and print its run and the PID gains derived from Table 2.
     Check {
-        /// The scene file (TOML).
+        /// The scene: a file (TOML) or a built-in scene's name (`margemu scenes`).
         scene: PathBuf,
     },
 }

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 #[derive(clap::Args)]
 pub struct Cmd {
-    /// The scene file (TOML).
+    /// The scene: a file (TOML) or a built-in scene's name (`margemu scenes`).
     scene: PathBuf,
     // Default: runs/<scene name>.
     #[command(flatten)]
@@ -24,7 +24,7 @@ impl Cmd {
         let stop = super::Interrupt::install()?.flag();
         let scene = super::load_scene(&self.scene)?;
         self.size.check(&scene)?;
-        let dir = self.output.prepare(&self.scene, "runs", "")?;
+        let dir = self.output.prepare(&scene, "runs", "")?;
         let bar =
             ProgressBar::with_draw_target(Some(scene.samples()), ProgressDrawTarget::hidden());
         bar.set_style(

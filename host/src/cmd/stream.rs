@@ -13,7 +13,7 @@ use std::time::Duration;
 
 #[derive(clap::Args)]
 pub struct Cmd {
-    /// The scene file (TOML).
+    /// The scene: a file (TOML) or a built-in scene's name (`margemu scenes`).
     scene: PathBuf,
     /// The device's serial port (e.g. /dev/ttyACM0, or a PTY path).
     #[arg(long)]
@@ -163,7 +163,7 @@ impl Cmd {
         };
         let port =
             open_port(&self.port, self.baud).with_context(|| format!("opening {}", self.port))?;
-        let dir = self.output.prepare(&self.scene, "sessions", "")?;
+        let dir = self.output.prepare(&scene, "sessions", "")?;
         let mut session = prepare(&scene, config, &dir)?;
         interrupt.watch(session.stop_flag());
         let dut = self.dut.attach(&mut session, &dir)?;

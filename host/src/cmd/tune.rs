@@ -11,7 +11,7 @@ use std::time::Instant;
 
 #[derive(clap::Args)]
 pub struct Cmd {
-    /// The scene file (TOML).
+    /// The scene: a file (TOML) or a built-in scene's name (`margemu scenes`).
     scene: PathBuf,
     /// The filters to tune, one after the other on the same seeds: ecf, gda, ekf (comma list).
     #[arg(long, value_delimiter = ',', required = true)]

@@ -8,7 +8,9 @@
 //! README ("Scene files"); every key is optional except `duration`, `rate` and `seed`.
 //!
 //! [`Scene::load`] reads, parses and validates a file. Every failure is a [`SceneError`] that
-//! names the file, the line and column, and the reason.
+//! names the file, the line and column, and the reason. The fixture scenes are built in
+//! ([`builtin`]): commands take a scene argument through [`builtin::resolve`], a file's path or
+//! a built-in scene's name.
 //!
 //! ```
 //! let scene = margemu::scene::Scene::parse_str(
@@ -18,6 +20,7 @@
 //! assert_eq!(scene.samples(), 200);
 //! ```
 
+pub mod builtin;
 pub mod chip;
 mod error;
 pub mod ranges;
@@ -38,7 +41,8 @@ use std::path::{Path, PathBuf};
 pub struct Scene {
     /// The scene's content.
     pub spec: SceneSpec,
-    /// The file it was read from (relative paths inside it resolve against its folder).
+    /// The file it was read from (relative paths inside it resolve against its folder), or
+    /// `builtin:NAME` for a built-in scene ([`builtin`]).
     pub path: PathBuf,
     /// The exact text of the file (kept for the run's metadata and hash).
     pub text: String,
@@ -135,6 +139,20 @@ impl Scene {
     /// file), for messages about what that value caused.
     pub fn location(&self, keys: &[&str]) -> String {
         SceneError::location(&self.path, &self.text, keys)
+    }
+
+    /// The scene's short name, which default run and session directory names use: a built-in
+    /// scene's name, or the file's name without its extension.
+    pub fn stem(&self) -> String {
+        match builtin::name_of(&self.path) {
+            Some(name) => name.to_owned(),
+            None => self
+                .path
+                .file_stem()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned(),
+        }
     }
 
     /// The folder relative paths in the scene resolve against.

@@ -69,6 +69,17 @@ pub enum MotionMode {
     Static,
 }
 
+impl MotionMode {
+    /// The mode's name in a scene file (`motion = "…"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionMode::Bench => "bench",
+            MotionMode::Kinematic => "kinematic",
+            MotionMode::Static => "static",
+        }
+    }
+}
+
 /// Integration method of the bench dynamics.
 #[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]

@@ -14,9 +14,9 @@
 //!
 //! ```no_run
 //! use margemu::offline::FilterKind;
-//! use margemu::scene::Scene;
+//! use margemu::scene::builtin;
 //! use margemu::tune::{tune, TuneOptions};
-//! let scene = Scene::load("hil-fixtures/scenes/case-study.toml".as_ref())?;
+//! let scene = builtin::load("case-study")?;
 //! let result = tune(&scene, FilterKind::Ekf, &TuneOptions::default())?;
 //! println!("{}", margemu::tune::report::table(&result));
 //! assert!(result.tuned.objective <= result.initial.objective);
