@@ -87,15 +87,21 @@ fn loopback_with_a_flight_controller_reads_back_and_scores_its_mavlink() {
     ] {
         assert!(session.join(file).is_file(), "{file} missing");
     }
-    // 2 s at 50 Hz: 100 of each message, in dut_attitude.csv and the session's records.
+    // 2 s at 50 Hz: 100 of each message, in dut_attitude.csv and the session's records. The
+    // flight controller's thread runs on the host's scheduler: starved, it may step over an
+    // output instant (as a real one would), so a few may be missing, never more than 5 %, and
+    // every record agrees on the count.
     let (_, rows) = csv(&session, "dut_attitude.csv");
-    assert_eq!(rows.len(), 200);
+    let quaternions = rows.iter().filter(|r| r.contains("ATTITUDE_QUATERNION")).count();
+    assert!((95..=100).contains(&quaternions), "{quaternions} quaternions");
+    assert_eq!(rows.len(), 2 * quaternions, "one ATTITUDE per ATTITUDE_QUATERNION");
     let (_, events) = csv(&session, "events.csv");
     let last = events.last().unwrap();
     assert!(
-        last.contains(
-            ",dut,mavlink: 202 messages (ATTITUDE 100; ATTITUDE_QUATERNION 100; HEARTBEAT 2)"
-        ),
+        last.contains(&format!(
+            ",dut,mavlink: {} messages (ATTITUDE {quaternions}; ATTITUDE_QUATERNION {quaternions}; HEARTBEAT 2)",
+            2 * quaternions + 2
+        )),
         "{last}"
     );
     let meta: toml::Table = std::fs::read_to_string(session.join("meta.toml"))
@@ -104,7 +110,7 @@ fn loopback_with_a_flight_controller_reads_back_and_scores_its_mavlink() {
         .unwrap();
     assert_eq!(
         meta["dut"]["per_message"]["ATTITUDE_QUATERNION"].as_integer(),
-        Some(100)
+        Some(quaternions as i64)
     );
 }
 
