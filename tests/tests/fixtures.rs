@@ -181,13 +181,17 @@ fn a_csv_trajectory_drives_kinematic_motion() {
 }
 
 #[test]
-fn the_readme_scene_example_is_a_valid_scene() {
-    let readme =
-        std::fs::read_to_string(margemu_tests::workspace_root().join("README.md")).unwrap();
-    let start = readme.find("```toml\n").expect("a TOML example") + "```toml\n".len();
-    let end = start + readme[start..].find("```").unwrap();
-    let scene = Scene::parse_str(&readme[start..end], std::path::Path::new("README.md"))
-        .unwrap_or_else(|e| panic!("{e}"));
+fn the_guides_full_scene_example_is_a_valid_scene() {
+    let guide =
+        std::fs::read_to_string(margemu_tests::workspace_root().join("docs/scene-files.md"))
+            .unwrap();
+    let start = guide.find("```toml\n").expect("a TOML example") + "```toml\n".len();
+    let end = start + guide[start..].find("```").unwrap();
+    let scene = Scene::parse_str(
+        &guide[start..end],
+        std::path::Path::new("docs/scene-files.md"),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     assert!(scene.spec.perturbation.is_some());
     assert!(scene.spec.sensors.gyro.noise_density.is_some());
     assert_eq!(truths(&scene).len() as u64, scene.samples());

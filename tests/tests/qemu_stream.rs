@@ -9,7 +9,7 @@
 //! Telemetry must report no underrun and no overrun.
 //!
 //! The rate, [`RATE_HZ`], is a third of what the benchmark (`tests/benches/qemu_rates.rs`,
-//! README) found QEMU's UART to sustain on a quiet machine, and the lead of 1.5 s puts most of
+//! `docs/figures.md`) found QEMU's UART to sustain on a quiet machine, and the lead of 1.5 s puts most of
 //! the scene in the device's buffer before Start: QEMU takes one byte per turn of its main loop,
 //! which slows far down beside CPU hogs. This test checks correctness; the benchmark the speed.
 //!

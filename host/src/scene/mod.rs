@@ -5,7 +5,7 @@
 //! (Table 1 as defaults), the control requirements (Table 2 as defaults), the integrator, the
 //! reference magnetic field, per joint a reference source, the sensor error terms and the
 //! magnetic perturbation ([`sensors`]). The schema is documented in the
-//! README ("Scene files"); every key is optional except `duration`, `rate` and `seed`.
+//! user guide (`docs/scene-files.md`); every key is optional except `duration`, `rate` and `seed`.
 //!
 //! [`Scene::load`] reads, parses and validates a file. Every failure is a [`SceneError`] that
 //! names the file, the line and column, and the reason. The fixture scenes are built in

@@ -12,7 +12,7 @@
 //! however late the poll) and queues the frames it sends. Under QEMU every MMIO access and every
 //! wake-up costs the emulator tens of microseconds of host time, and received bytes arrive one
 //! per turn of its main loop; waking the loop once per byte instead, or spinning, measurably
-//! slows the link (see the README's QEMU figures). A real board with a DUT polling the chip
+//! slows the link (see the QEMU figures in `docs/figures.md`). A real board with a DUT polling the chip
 //! would serve each instant from a timer compare instead of a tick.
 //!
 //! The link is binary from the first byte: no banner (the device's power-on Reset frame is the
