@@ -12,6 +12,7 @@
 //! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
 //! - [`guard`]: the run stops at the first truth or sample value that is not finite;
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
+//! - [`meta`]: the schema of `meta.toml`, written and read by the same types;
 //! - [`rundir`]: which directory a run writes to, and the completion record written last;
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
 //! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
@@ -37,6 +38,7 @@ pub mod guard;
 pub mod input_file;
 pub mod loopback;
 pub mod marg;
+pub mod meta;
 pub mod motion;
 pub mod offline;
 pub mod output;

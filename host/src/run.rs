@@ -3,13 +3,13 @@
 
 use crate::bench::{pid::Design, FrictionEvent};
 use crate::marg::{MargSim, MargWriter};
+use crate::meta::{PidMeta, RunMeta};
 use crate::motion::Motion;
 use crate::output::{TruthWriter, RUN_FILES, TRUTH_COLUMNS};
 use crate::reference::ReferenceError;
 use crate::rundir::{self, Completion, Status};
 use crate::scene::{Scene, JOINT_NAMES};
 use crate::truth::{Truth, TruthModel};
-use serde::Serialize;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
@@ -128,7 +128,7 @@ pub fn simulate_to_dir(
     progress: impl FnMut(u64, u64),
 ) -> Result<RunSummary, RunError> {
     std::fs::create_dir_all(dir).map_err(write_err(dir))?;
-    rundir::write_meta(dir, &metadata(scene)).map_err(write_err(&dir.join(rundir::META_FILE)))?;
+    crate::meta::write(dir, &metadata(scene)).map_err(write_err(&dir.join(rundir::META_FILE)))?;
     let mut written = 0;
     let outcome = write_files(scene, dir, stop, &mut written, progress);
     let (status, ended) = match &outcome {
@@ -209,37 +209,8 @@ fn write_files(
     Ok(summary)
 }
 
-#[derive(Serialize)]
-struct Meta<'a> {
-    margemu_version: &'a str,
-    scene_file: String,
-    scene_sha256: String,
-    seed: u64,
-    motion: String,
-    rate_hz: f64,
-    duration_s: f64,
-    samples: u64,
-    integrator: String,
-    integrator_step_s: f64,
-    field_unit: &'a str,
-    truth_columns: Vec<&'a str>,
-    pid: Vec<PidMeta>,
-    scene_text: &'a str,
-}
-
-#[derive(Serialize)]
-struct PidMeta {
-    joint: &'static str,
-    kp: f64,
-    ki: f64,
-    kd: f64,
-    zeta: Option<f64>,
-    natural_frequency: Option<f64>,
-    time_constant: Option<f64>,
-}
-
 /// The run's `meta.toml`: scene, its SHA-256, seed, settings, PID gains and the scene text.
-pub fn metadata(scene: &Scene) -> String {
+pub fn metadata(scene: &Scene) -> RunMeta {
     let spec = &scene.spec;
     let designs = crate::bench::designs(scene);
     let pid = JOINT_NAMES
@@ -253,7 +224,7 @@ pub fn metadata(scene: &Scene) -> String {
                 (None, None) => [f64::NAN; 3],
             };
             PidMeta {
-                joint,
+                joint: joint.to_string(),
                 kp,
                 ki,
                 kd,
@@ -263,8 +234,8 @@ pub fn metadata(scene: &Scene) -> String {
             }
         })
         .collect();
-    let meta = Meta {
-        margemu_version: env!("CARGO_PKG_VERSION"),
+    RunMeta {
+        margemu_version: env!("CARGO_PKG_VERSION").to_string(),
         scene_file: scene.path.display().to_string(),
         scene_sha256: scene.hash(),
         seed: spec.seed,
@@ -274,10 +245,10 @@ pub fn metadata(scene: &Scene) -> String {
         samples: scene.samples(),
         integrator: format!("{:?}", spec.integrator.method),
         integrator_step_s: spec.integrator.step,
-        field_unit: spec.field.unit.symbol(),
-        truth_columns: TRUTH_COLUMNS.to_vec(),
+        field_unit: spec.field.unit.symbol().to_string(),
+        truth_columns: TRUTH_COLUMNS.iter().map(|c| c.to_string()).collect(),
         pid,
-        scene_text: &scene.text,
-    };
-    toml::to_string(&meta).expect("metadata serializes")
+        scene_text: scene.text.clone(),
+        completion: None,
+    }
 }

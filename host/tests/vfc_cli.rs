@@ -92,9 +92,19 @@ fn loopback_with_a_flight_controller_reads_back_and_scores_its_mavlink() {
     // output instant (as a real one would), so a few may be missing, never more than 5 %, and
     // every record agrees on the count.
     let (_, rows) = csv(&session, "dut_attitude.csv");
-    let quaternions = rows.iter().filter(|r| r.contains("ATTITUDE_QUATERNION")).count();
-    assert!((95..=100).contains(&quaternions), "{quaternions} quaternions");
-    assert_eq!(rows.len(), 2 * quaternions, "one ATTITUDE per ATTITUDE_QUATERNION");
+    let quaternions = rows
+        .iter()
+        .filter(|r| r.contains("ATTITUDE_QUATERNION"))
+        .count();
+    assert!(
+        (95..=100).contains(&quaternions),
+        "{quaternions} quaternions"
+    );
+    assert_eq!(
+        rows.len(),
+        2 * quaternions,
+        "one ATTITUDE per ATTITUDE_QUATERNION"
+    );
     let (_, events) = csv(&session, "events.csv");
     let last = events.last().unwrap();
     assert!(

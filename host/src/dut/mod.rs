@@ -63,6 +63,7 @@ pub use decode::{DecodeCounters, Decoded, MessageInfo, Sample, Wire};
 pub use frames::Attitude;
 pub use reader::{spawn_dut_reader, DutConfig, DutProgress, DutReader};
 
+use crate::meta::DutMeta;
 use std::collections::BTreeMap;
 use std::fmt;
 use std::path::PathBuf;
@@ -152,27 +153,23 @@ impl DutSummary {
         self.messages.values().sum()
     }
 
-    /// A `[dut]` table for `meta.toml`.
-    pub fn meta_toml(&self) -> String {
+    /// The `[dut]` table of `meta.toml`.
+    pub fn meta(&self) -> DutMeta {
         let c = &self.counters;
-        let mut s = format!(
-            "\n[dut]\nprotocol = \"{}\"\nmessages = {}\nattitude_rows = {}\nimu_rows = {}\nbytes = {}\nbad_bytes = {}\nbad_frames = {}\nunknown_ids = {}\nundecoded = {}\nrequests_sent = {}\nend = \"{}\"\n\n[dut.per_message]\n",
-            self.protocol.as_str(),
-            self.total_messages(),
-            self.attitude_rows,
-            self.imu_rows,
-            c.bytes,
-            c.bad_bytes,
-            c.bad_frames,
-            c.unknown_ids,
-            c.undecoded,
-            self.requests_sent,
-            self.end.to_string().replace(['"', '\\'], "'"),
-        );
-        for (name, n) in &self.messages {
-            s.push_str(&format!("{name} = {n}\n"));
+        DutMeta {
+            protocol: self.protocol.as_str().to_string(),
+            messages: self.total_messages(),
+            attitude_rows: self.attitude_rows,
+            imu_rows: self.imu_rows,
+            bytes: c.bytes,
+            bad_bytes: c.bad_bytes,
+            bad_frames: c.bad_frames,
+            unknown_ids: c.unknown_ids,
+            undecoded: c.undecoded,
+            requests_sent: self.requests_sent,
+            end: self.end.to_string(),
+            per_message: self.messages.clone(),
         }
-        s
     }
 }
 

@@ -2,7 +2,8 @@
 //! what the device was sent (`sent.csv`, decoded back to physical units for the norm plots and
 //! the magnetic phase).
 //!
-//! Scene time 0 is `start_host_ns` from `meta.toml` when present, otherwise from the `start`
+//! `meta.toml` is read through its schema ([`crate::meta`]). Scene time 0 is `start_host_ns`
+//! from a `meta.toml` written by hand ([`ForeignMeta`]) when present, otherwise from the `start`
 //! row of `events.csv` (`detail` = `start_host_ns N; …`, as `margemu stream` writes it).
 //!
 //! Register images are decoded by the chip module of `meta.toml`'s `[chip] model` (the MPU-9250
@@ -14,11 +15,11 @@
 
 use crate::csv_column::ColumnError;
 use crate::csv_table::Table;
+use crate::meta::{ForeignMeta, MetaFile};
 use crate::stream::parse_image_hex;
 use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion, FullScale};
 use margemu_protocol::regmap::ak8963::MagBits;
 use margemu_protocol::regmap::mpu6xxx::AccelFs;
-use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 /// A session file that says something unusable.
@@ -41,29 +42,6 @@ impl From<ColumnError> for SessionFileError {
     }
 }
 
-#[derive(Deserialize, Default)]
-struct MetaFile {
-    start_host_ns: Option<i64>,
-    mag_ut_per_unit: Option<f64>,
-    chip: Option<ChipMeta>,
-    image: Option<ImageMeta>,
-}
-
-#[derive(Deserialize)]
-struct ChipMeta {
-    model: String,
-    accel_range_g: f64,
-    gyro_range_dps: f64,
-}
-
-#[derive(Deserialize)]
-struct ImageMeta {
-    accel_fs: String,
-    mag_bits: String,
-    asa: [u8; 3],
-    accel_offset: [i16; 3],
-}
-
 /// What evaluation needs from a session's `meta.toml` and `events.csv`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SessionMeta {
@@ -84,14 +62,16 @@ fn bad(path: &Path, reason: impl Into<String>) -> SessionFileError {
 
 /// Reads `dir/meta.toml` (and `dir/events.csv` when `meta.toml` has no `start_host_ns`).
 pub fn read_meta(dir: &Path) -> Result<SessionMeta, SessionFileError> {
-    let path = dir.join("meta.toml");
-    let text = crate::input_file::read_to_string(&path).map_err(|e| bad(&path, e.reason()))?;
-    let meta: MetaFile = toml::from_str(&text).map_err(|e| bad(&path, e.to_string()))?;
-    let start_host_ns = match meta.start_host_ns {
-        Some(ns) => ns,
-        None => start_from_events(&dir.join("events.csv"))?,
+    let file = crate::meta::read(dir).map_err(|e| bad(&e.path, e.reason))?;
+    let path = dir.join(crate::rundir::META_FILE);
+    let start_host_ns = match &file {
+        MetaFile::Foreign(ForeignMeta {
+            start_host_ns: Some(ns),
+        }) => *ns,
+        _ => start_from_events(&dir.join("events.csv"))?,
     };
-    let mut chip = match &meta.chip {
+    let meta = file.session();
+    let mut chip = match meta.map(|m| &m.chip) {
         None => ChipSettings::power_on(ChipModel::Mpu9250),
         Some(c) => {
             let model = ChipModel::from_name(&c.model)
@@ -104,7 +84,9 @@ pub fn read_meta(dir: &Path) -> Result<SessionMeta, SessionFileError> {
                 .map_err(|e| bad(&path, format!("[chip]: {e:?}")))?
         }
     };
-    if let (Some(m), Conversion::Mpu6xxx(image)) = (meta.image, &mut chip.conversion) {
+    if let (Some(m), Conversion::Mpu6xxx(image)) =
+        (meta.and_then(|m| m.image.as_ref()), &mut chip.conversion)
+    {
         image.accel_fs = pick(&path, "accel_fs", &m.accel_fs, &AccelFs::ALL)?;
         image.mag_bits = pick(
             &path,
@@ -118,7 +100,7 @@ pub fn read_meta(dir: &Path) -> Result<SessionMeta, SessionFileError> {
     Ok(SessionMeta {
         start_host_ns,
         chip,
-        mag_ut_per_unit: meta.mag_ut_per_unit.unwrap_or(1.0),
+        mag_ut_per_unit: meta.map_or(1.0, |m| m.mag_ut_per_unit),
     })
 }
 

@@ -120,7 +120,7 @@ pub fn open(path: &Path, mag_reference: Option<[f64; 3]>) -> Result<Samples, Inp
         )?;
         let reference = match mag_reference {
             Some(r) => r,
-            None => scene_field(&path.join("meta.toml"))?,
+            None => scene_field(path)?,
         };
         (Rows::Run(rows), reference, marg)
     } else if !path.exists() {
@@ -190,17 +190,19 @@ pub fn first_true_attitude(dir: &Path) -> Result<[f64; 4], InputError> {
         .ok_or_else(|| bad(&path, "no samples"))
 }
 
-/// The `[field] reference` of the scene text in a run's `meta.toml`.
-fn scene_field(meta: &Path) -> Result<[f64; 3], InputError> {
-    #[derive(Deserialize)]
-    struct Meta {
-        scene_text: String,
-    }
-    let text = crate::input_file::read_to_string(meta)
-        .map_err(|e| bad(meta, format!("{}; pass --mag-reference", e.reason())))?;
-    let m: Meta = toml::from_str(&text).map_err(|e| bad(meta, e.message().trim().to_owned()))?;
-    let scene = Scene::parse_str(&m.scene_text, &meta.join("scene_text"))
-        .map_err(|e| bad(meta, format!("its scene text is not a valid scene: {e}")))?;
+/// The `[field] reference` of the scene text in the `meta.toml` of the run in `dir`.
+fn scene_field(dir: &Path) -> Result<[f64; 3], InputError> {
+    let file = crate::meta::read(dir)
+        .map_err(|e| bad(&e.path, format!("{}; pass --mag-reference", e.reason)))?;
+    let meta = dir.join(crate::rundir::META_FILE);
+    let text = file.scene_text().ok_or_else(|| {
+        bad(
+            &meta,
+            "not written by margemu: it has no scene text; pass --mag-reference",
+        )
+    })?;
+    let scene = Scene::parse_str(text, &meta.join("scene_text"))
+        .map_err(|e| bad(&meta, format!("its scene text is not a valid scene: {e}")))?;
     Ok(scene.spec.field.reference)
 }
 

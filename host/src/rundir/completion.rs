@@ -1,11 +1,12 @@
 //! The completion record: the `[completion]` table of `meta.toml` ([`Completion`], one serde
-//! type for writing and reading), the check `evaluate` makes, and the record shared by the
+//! type for writing and reading, a table of the [`crate::meta`] schema), the check `evaluate` makes, and the record shared by the
 //! writers of one directory ([`CompletionRecord`]).
 
 use super::{RunDirError, META_FILE};
+use crate::meta::{Appended, MetaFile};
 use serde::{Deserialize, Serialize};
 use std::fmt;
-use std::io::{self, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
@@ -70,39 +71,22 @@ impl fmt::Display for Completion {
     }
 }
 
-/// What [`read_completion`] reads of `meta.toml`.
-#[derive(Deserialize)]
-struct MetaHead {
-    margemu_version: Option<String>,
-    completion: Option<Completion>,
-}
-
 /// Appends the `[completion]` table to `dir/meta.toml` and syncs it to the disk.
 pub fn write_completion(dir: &Path, completion: &Completion) -> io::Result<()> {
-    let table = toml::to_string(completion).map_err(io::Error::other)?;
-    let mut meta = std::fs::OpenOptions::new()
-        .append(true)
-        .open(dir.join(META_FILE))?;
-    meta.write_all(format!("\n[completion]\n{table}").as_bytes())?;
-    meta.sync_all()
+    crate::meta::append(dir, Appended::Completion(completion))
 }
 
 /// The completion record of `dir`: `Ok(None)` if margemu wrote `meta.toml` but the run has no
 /// record (it was killed, or is still running). Fails if there is no `meta.toml` or it does not
 /// parse.
 pub fn read_completion(dir: &Path) -> Result<Option<Completion>, RunDirError> {
-    Ok(read_head(dir)?.completion)
+    Ok(read_meta(dir)?.completion().cloned())
 }
 
-fn read_head(dir: &Path) -> Result<MetaHead, RunDirError> {
-    let path = dir.join(META_FILE);
-    let text = crate::input_file::read_to_string(&path).map_err(|e| RunDirError::BadMeta {
-        path: path.clone(),
-        reason: e.reason(),
-    })?;
-    toml::from_str(&text).map_err(|e| RunDirError::BadMeta {
-        path,
-        reason: e.to_string(),
+fn read_meta(dir: &Path) -> Result<MetaFile, RunDirError> {
+    crate::meta::read(dir).map_err(|e| RunDirError::BadMeta {
+        path: e.path,
+        reason: e.reason,
     })
 }
 
@@ -114,11 +98,11 @@ pub fn check_complete(dir: &Path, allow_incomplete: bool) -> Result<Option<Strin
     if !dir.join(META_FILE).is_file() {
         return Ok(None);
     }
-    let head = read_head(dir)?;
-    if head.margemu_version.is_none() {
+    let meta = read_meta(dir)?;
+    if let MetaFile::Foreign(_) = meta {
         return Ok(None);
     }
-    let why = match head.completion {
+    let why = match meta.completion().cloned() {
         Some(c) if c.status == Status::Complete => return Ok(None),
         Some(c) => format!("meta.toml's completion record says {c}"),
         None => {

@@ -289,7 +289,12 @@ mod tests {
     fn completion_is_written_by_the_last_holder() {
         let dir = scratch("holders");
         std::fs::create_dir_all(&dir).unwrap();
-        write_meta(&dir, "margemu_version = \"0\"\n").unwrap();
+        let scene = crate::scene::Scene::parse_str(
+            "duration = 0.1\nrate = 100.0\nseed = 1\n",
+            Path::new("s.toml"),
+        )
+        .unwrap();
+        crate::meta::write(&dir, &crate::run::metadata(&scene)).unwrap();
         let record = CompletionRecord::new(&dir);
         let other = record.clone();
         record.update(|c| {

@@ -8,6 +8,7 @@ use super::rx::{self, RxEvent};
 use super::served::ServedCheck;
 use super::session::Session;
 use super::{Lateness, LinkStats, Progress, StreamError, Summary};
+use crate::meta::Appended;
 use margemu_protocol::link::{Credit, Encoder, Hello, HelloAck, Message, RxStats, Telemetry};
 use margemu_protocol::PROTOCOL_VERSION;
 use std::io::Write;
@@ -233,7 +234,10 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             return Err(StreamError::Unsupported { reason });
         }
         let device = device_meta(&ack);
-        let appended = self.session.log.write(move |log| log.append_meta(&device));
+        let appended = self
+            .session
+            .log
+            .write(move |log| log.append_meta(Appended::Device(&device)));
         appended.map_err(self.log_err())
     }
 

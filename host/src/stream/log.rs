@@ -21,6 +21,7 @@
 //! ended; [`crate::rundir`]), written once every file is closed: after the session, or after
 //! the device under test's reader when one is attached.
 
+use crate::meta::{Appended, SessionMeta};
 use crate::output::{TruthWriter, TRUTH_FILE};
 use crate::truth::Truth;
 use margemu_model::sensor;
@@ -95,9 +96,9 @@ fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
 impl SessionLog {
     /// Creates `dir` and every file, with their headers (`sent_columns`: the
     /// source mode's), and writes `meta.toml`.
-    pub fn create(dir: &Path, meta: &str, sent_columns: &str) -> io::Result<Self> {
+    pub fn create(dir: &Path, meta: &SessionMeta, sent_columns: &str) -> io::Result<Self> {
         std::fs::create_dir_all(dir)?;
-        crate::rundir::write_meta(dir, meta)?;
+        crate::meta::write(dir, meta)?;
         let mut log = Self {
             dir: dir.to_path_buf(),
             float: ryu::Buffer::new(),
@@ -121,12 +122,9 @@ impl SessionLog {
         &self.dir
     }
 
-    /// Appends `text` to `meta.toml`.
-    pub fn append_meta(&mut self, text: &str) -> io::Result<()> {
-        let mut meta = std::fs::OpenOptions::new()
-            .append(true)
-            .open(self.dir.join(crate::rundir::META_FILE))?;
-        meta.write_all(text.as_bytes())
+    /// Appends `table` to `meta.toml`.
+    pub fn append_meta(&mut self, table: Appended<'_>) -> io::Result<()> {
+        crate::meta::append(&self.dir, table)
     }
 
     /// Rows of `truth.csv`, in order.

@@ -170,13 +170,9 @@ pub fn evaluate_session(
 /// Whether the chip of the session in `dir` has a magnetometer, by `meta.toml`'s `[chip]
 /// model`; `true` when that cannot be read (the MPU-9250, the default chip, has one).
 pub fn session_has_magnetometer(dir: &std::path::Path) -> bool {
-    let model = crate::input_file::read_to_string(&dir.join("meta.toml"))
+    let model = crate::meta::read(dir)
         .ok()
-        .and_then(|text| text.parse::<toml::Table>().ok())
-        .and_then(|meta| {
-            let name = meta.get("chip")?.get("model")?.as_str()?.to_owned();
-            margemu_protocol::chip::ChipModel::from_name(&name)
-        });
+        .and_then(|meta| margemu_protocol::chip::ChipModel::from_name(&meta.session()?.chip.model));
     model.is_none_or(|m| m.has_magnetometer())
 }
 

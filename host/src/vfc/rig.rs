@@ -17,6 +17,7 @@ use super::uart::{self, UartReport, UartThread};
 use super::VfcConfig;
 use crate::dut::{DutConfig, DutError, DutProgress, DutProtocol, DutReader, DutSummary};
 use crate::loopback::{spawn_device_with_local, DeviceReport, LoopbackDevice};
+use crate::meta::Appended;
 use crate::rundir::CompletionRecord;
 use crate::scene::Scene;
 use crate::stream::{Progress, Session, StreamConfig, StreamError, Summary};
@@ -210,12 +211,7 @@ impl AttachedDut {
             &self.dir.join(crate::stream::log::EVENTS_FILE),
             &format!("{host_ns},dut,{detail}\n"),
         )
-        .and_then(|()| {
-            append(
-                &self.dir.join(crate::rundir::META_FILE),
-                &summary.meta_toml(),
-            )
-        })
+        .and_then(|()| crate::meta::append(&self.dir, Appended::Dut(&summary.meta())))
         .inspect_err(|e| {
             fail(format!(
                 "cannot record the device under test's summary: {e}"
