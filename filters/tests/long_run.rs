@@ -58,7 +58,7 @@ impl<T: Real> Bank<T> {
             self.sq_err[i] += geodesic_angle(q, truth).powi(2);
         }
         assert!(self.ekf.bias().iter().all(|c| c.to_f64().is_finite()));
-        if k % RATE as usize == 0 {
+        if k.is_multiple_of(RATE as usize) {
             self.check_covariance(k);
         }
     }

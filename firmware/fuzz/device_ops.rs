@@ -248,7 +248,7 @@ impl Harness {
     }
 
     fn spi(&mut self, input: &mut Input<'_>) {
-        let (first, n, deselect) = (input.u8(), input.u8() % 40, input.u8() % 8 != 0);
+        let (first, n, deselect) = (input.u8(), input.u8() % 40, !input.u8().is_multiple_of(8));
         let chip = self.device.chip_mut();
         chip.select();
         chip.exchange(first);
@@ -266,9 +266,9 @@ impl Harness {
             input.u8() & 0x7F,
             input.u8(),
             input.u8() % 40,
-            input.u8() % 8 != 0,
+            !input.u8().is_multiple_of(8),
         );
-        let write = input.u8() % 2 == 0;
+        let write = input.u8().is_multiple_of(2);
         let value = input.u8();
         let chip = self.device.chip_mut();
         if chip.start(address, false) {

@@ -77,7 +77,7 @@ impl SampleClock {
 
     /// Whether the period is a whole number of nanoseconds.
     pub fn is_integral(&self) -> bool {
-        self.num % self.den == 0
+        self.num.is_multiple_of(self.den)
     }
 }
 

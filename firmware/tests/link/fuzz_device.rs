@@ -30,6 +30,18 @@ fn a_streaming_session_passes_the_harness_checks() {
     assert_eq!(device_ops::run(&streaming_seed()), 13);
 }
 
+/// With `MARGEMU_FUZZ_SEEDS=dir`, writes the seed corpus for `firmware/fuzz`: `dir/device/`
+/// (the streaming session above, which the fuzzer then mutates).
+#[test]
+fn write_fuzz_seeds() {
+    let Some(dir) = std::env::var_os("MARGEMU_FUZZ_SEEDS") else {
+        return;
+    };
+    let device = std::path::Path::new(&dir).join("device");
+    std::fs::create_dir_all(&device).unwrap();
+    std::fs::write(device.join("streaming-session"), streaming_seed()).unwrap();
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(512))]
 

@@ -29,7 +29,7 @@ fn truth(j: u64) -> Truth {
         specific_force: [0.5 * x, -0.1, 9.80665],
         magnetic_field: [0.4, 0.05 * x, -0.8],
         angular_acceleration: [0.0, x, 0.0],
-        temperature_c: (j % 3 != 0).then_some(25.0 + x),
+        temperature_c: (!j.is_multiple_of(3)).then_some(25.0 + x),
     }
 }
 

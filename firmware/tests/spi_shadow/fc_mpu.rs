@@ -105,7 +105,7 @@ fn ardupilot_with_compass(rig: &mut dyn Rig, samples: usize, compass: bool) -> V
             decoded.extend(burst(rig, FIFO_R_W, records.min(8) * 14));
         }
         polls += 1;
-        if polls % 20 == 0 {
+        if polls.is_multiple_of(20) {
             let (reg, value) = checked[check % checked.len()];
             check += 1;
             rig.set_fast(false);

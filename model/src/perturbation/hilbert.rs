@@ -36,7 +36,7 @@ pub fn analytic(data: &mut [Complex], fft: &FftPlan, scratch: &mut [Complex]) ->
     let half = n / 2;
     let inv_n = 1.0 / n as f64;
     for (l, z) in data.iter_mut().enumerate() {
-        let h = if l == 0 || (n % 2 == 0 && l == half) {
+        let h = if l == 0 || (n.is_multiple_of(2) && l == half) {
             1.0
         } else if l < n.div_ceil(2) {
             2.0

@@ -55,7 +55,7 @@ impl Mpu6xxx {
         }
         self.slv4_transfer();
         let delay = self.regs[usize::from(reg::I2C_SLV4_CTRL)] & bits::SLV4_MST_DLY;
-        let delayed_turn = self.aux.samples % (u32::from(delay) + 1) == 0;
+        let delayed_turn = self.aux.samples.is_multiple_of(u32::from(delay) + 1);
         self.aux.samples = self.aux.samples.wrapping_add(1);
         let delay_ctrl = self.regs[usize::from(reg::I2C_MST_DELAY_CTRL)];
 
