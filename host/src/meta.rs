@@ -2,7 +2,7 @@
 //! once: every writer serialises these types and every reader deserialises them.
 //!
 //! A `simulate` run writes a [`RunMeta`], a session (`loopback`, `stream`) a [`SessionMeta`],
-//! whole, when it begins ([`write`]). Tables are appended later, each serialised from its type
+//! whole, when it begins ([`write()`]). Tables are appended later, each serialised from its type
 //! ([`append`]): a session's [`DeviceMeta`] (`[device]`, after the handshake) and, with a device
 //! under test, its reader's [`DutMeta`] (`[dut]`); last, in every directory, the completion
 //! record ([`Completion`], `[completion]`; see [`crate::rundir`]). The appended tables are
