@@ -154,13 +154,7 @@ fn joint_driver(scene: &Scene, motion: &Motion, i: usize, t_ns: u64) -> String {
 
 /// Checks sensor sample `index`.
 pub fn check_sample(scene: &Scene, index: u64, s: &MargSample) -> Result<(), Box<NonFinite>> {
-    let values = s
-        .sample
-        .acc
-        .iter()
-        .chain(&s.sample.gyr)
-        .chain(&s.sample.mag);
-    let Some((k, &value)) = values.enumerate().find(|(_, v)| !v.is_finite()) else {
+    let Some((k, &value)) = s.values().enumerate().find(|(_, v)| !v.is_finite()) else {
         return Ok(());
     };
     let sensor = ["accel", "gyro", "mag"][k / 3];

@@ -46,6 +46,15 @@ pub struct MargSample {
     pub disturbance: [f32; 3],
 }
 
+impl MargSample {
+    /// The nine readings in `marg.csv`'s column order: accelerometer, gyroscope, magnetometer
+    /// (x, y, z each).
+    pub fn values(&self) -> impl Iterator<Item = &f32> {
+        let s = &self.sample;
+        s.acc.iter().chain(&s.gyr).chain(&s.mag)
+    }
+}
+
 impl MargSim {
     /// The model of `scene` (already validated, so this fails only on a model it refused).
     pub fn new(scene: &Scene) -> Result<Self, margemu_model::Error> {
@@ -136,13 +145,7 @@ impl<W: Write> MargWriter<W> {
 
     /// Writes one sample.
     pub fn write(&mut self, s: &MargSample) -> io::Result<()> {
-        let values = s
-            .sample
-            .acc
-            .iter()
-            .chain(&s.sample.gyr)
-            .chain(&s.sample.mag);
-        write_row(&mut self.marg, &mut self.float, s.t_ns, values)?;
+        write_row(&mut self.marg, &mut self.float, s.t_ns, s.values())?;
         if let Some(p) = self.perturbation.as_mut() {
             write_row(p, &mut self.float, s.t_ns, s.disturbance.iter())?;
         }

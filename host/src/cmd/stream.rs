@@ -207,7 +207,15 @@ pub fn stream_to(
     port: serialport::TTYPort,
     label: &str,
 ) -> Result<margemu::stream::Summary> {
-    eprintln!("image settings: {:?}", session.image_settings());
+    let images = session.image_settings();
+    let fs = images.chip.full_scale();
+    eprintln!(
+        "images: {}, ±{} g, ±{} °/s, {} µT per field unit",
+        images.chip.model.part_name(),
+        fs.accel_g,
+        fs.gyro_dps,
+        images.mag_ut_per_unit
+    );
     let bar = ProgressBar::new(session.sample_count());
     bar.set_style(
         ProgressStyle::with_template("{bar:30} {pos}/{len} sent {msg}").expect("valid template"),
