@@ -70,21 +70,8 @@ fn sigterm_keeps_the_flight_controllers_summary() {
 #[test]
 fn sigterm_ends_a_simulation_with_its_record() {
     let work = scratch("sigterm-simulate");
-    // 10⁸ samples: long enough to be caught running, beyond the size limit.
-    let scene = long_scene(&work, 100_000.0);
-    let dir = work.join("run");
-    let args: Vec<&OsStr> = vec![
-        "simulate".as_ref(),
-        scene.as_os_str(),
-        "-o".as_ref(),
-        dir.as_os_str(),
-        "--allow-large".as_ref(),
-    ];
-    let mut child = spawn_margemu(&args, &work);
+    let (child, dir) = common::simulating(&work);
     let partial = dir.join("truth.csv.partial");
-    wait_until(&mut child, "truth rows", || {
-        std::fs::metadata(&partial).is_ok_and(|m| m.len() > 1 << 20)
-    });
     send_signal(&child, "TERM");
     let out = child.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(1));

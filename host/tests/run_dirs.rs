@@ -164,20 +164,7 @@ fn assert_refused_as_incomplete(work: &Path, args: &[&OsStr], why: &str) {
 #[test]
 fn kill_9_during_simulate_leaves_a_run_evaluate_refuses() {
     let work = scratch("kill-simulate");
-    // 10⁸ samples: long enough to be caught running, beyond the size limit.
-    let scene = long_scene(&work, 100_000.0);
-    let dir = work.join("run");
-    let args: Vec<&OsStr> = vec![
-        "simulate".as_ref(),
-        scene.as_os_str(),
-        "-o".as_ref(),
-        dir.as_os_str(),
-        "--allow-large".as_ref(),
-    ];
-    let mut child = spawn_margemu(&args, &work);
-    wait_until(&mut child, "truth rows", || {
-        std::fs::metadata(dir.join("truth.csv.partial")).is_ok_and(|m| m.len() > 1 << 20)
-    });
+    let (mut child, dir) = common::simulating(&work);
     child.kill().unwrap();
     child.wait().unwrap();
     assert_eq!(completion(&dir), None);

@@ -185,6 +185,27 @@ pub fn long_scene(dir: &Path, seconds: f64) -> PathBuf {
     path
 }
 
+/// `simulate` of a 10⁸-sample scene into `work/run` (long enough to be caught running, beyond
+/// the size limit, so `--allow-large`), once it has written more than 1 MiB of truth rows: the
+/// process and the run directory.
+pub fn simulating(work: &Path) -> (std::process::Child, PathBuf) {
+    let scene = long_scene(work, 100_000.0);
+    let dir = work.join("run");
+    let args: Vec<&OsStr> = vec![
+        "simulate".as_ref(),
+        scene.as_os_str(),
+        "-o".as_ref(),
+        dir.as_os_str(),
+        "--allow-large".as_ref(),
+    ];
+    let mut child = spawn_margemu(&args, work);
+    let partial = dir.join("truth.csv.partial");
+    wait_until(&mut child, "truth rows", || {
+        std::fs::metadata(&partial).is_ok_and(|m| m.len() > 1 << 20)
+    });
+    (child, dir)
+}
+
 /// The `[completion]` table of `dir/meta.toml`.
 pub fn completion(dir: &Path) -> Option<margemu::rundir::Completion> {
     margemu::rundir::read_completion(dir).unwrap()
