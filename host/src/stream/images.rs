@@ -23,7 +23,7 @@
 //! assert_eq!(&samples[0].image[4..6], &[0x40, 0x00]);
 //! ```
 
-use super::predictor::{run_scene, Predictions, ReaderGone};
+use super::predictor::{run_scene, Halt, Predictions};
 use crate::marg::MargSim;
 use crate::scene::chip::ChipSetup;
 use crate::scene::{FieldUnit, Scene};
@@ -79,15 +79,11 @@ pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<Pr
     Predictions::spawn(move |emit| {
         let mut marg = MargSim::new(&scene).map_err(crate::run::RunError::Model)?;
         let temperature = scene.spec.sensors.temperature;
-        let mut non_finite = None;
         run_scene(&scene, |truth| {
-            let s = match marg.try_sample(&scene, &in_chip_axes(truth, &scene.chip)) {
-                Ok(s) => s.sample,
-                Err(e) => {
-                    non_finite = Some(e);
-                    return Err(ReaderGone);
-                }
-            };
+            let s = marg
+                .try_sample(&scene, &in_chip_axes(truth, &scene.chip))
+                .map_err(|e| Halt::Failed(crate::run::RunError::NonFinite(e)))?
+                .sample;
             // Same expression as `MargSim`, so the temperature the model sees is the one sent.
             let temp_c = temperature.map_or(settings.default_temp_c, |[start, slope]| {
                 (start + slope * truth.t_ns as f64 * 1e-9) as f32
@@ -100,12 +96,11 @@ pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<Pr
                     .map(|v| (f64::from(v) * settings.mag_ut_per_unit) as f32),
                 temp_c,
             };
-            emit(PredictedSample {
+            Ok(emit(PredictedSample {
                 truth: *truth,
                 image: settings.chip.image(&sample),
-            })
-        })?;
-        non_finite.map_or(Ok(()), |e| Err(crate::run::RunError::NonFinite(e)))
+            })?)
+        })
     })
 }
 

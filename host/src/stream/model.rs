@@ -121,13 +121,13 @@ pub fn predict_model(
             let t = held.as_ref().expect("sample 0 brings kinematics");
             let image = setup::model_image(&mut marg, t, params.mag_ut_per_unit, &chip);
             k += 1;
-            emit(ModelSample {
+            Ok(emit(ModelSample {
                 sample: PredictedSample {
                     truth: *truth,
                     image,
                 },
                 kinematics,
-            })
+            })?)
         })
     });
     Ok(ModelPrediction {

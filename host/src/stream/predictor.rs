@@ -19,6 +19,18 @@ pub const DEPTH: usize = 16;
 /// The producer asked the run to stop: its reader is gone.
 pub(super) struct ReaderGone;
 
+/// Why a producer stops a run early: its reader is gone (not an error), or it failed.
+pub(super) enum Halt {
+    ReaderGone,
+    Failed(RunError),
+}
+
+impl From<ReaderGone> for Halt {
+    fn from(_: ReaderGone) -> Self {
+        Halt::ReaderGone
+    }
+}
+
 /// Emits one item; `Err(ReaderGone)` once nobody reads any more.
 pub(super) type Emit<'a, T> = &'a mut dyn FnMut(T) -> Result<(), ReaderGone>;
 
@@ -96,13 +108,14 @@ impl<T> Drop for Predictions<T> {
 }
 
 /// Runs `scene` through [`run::run`](crate::run::run), handing each truth to `each` until it
-/// reports the reader gone.
+/// halts: a reader gone ends the run without error, a failure is the run's error.
 pub(super) fn run_scene(
     scene: &crate::scene::Scene,
-    each: impl FnMut(&crate::truth::Truth) -> Result<(), ReaderGone>,
+    each: impl FnMut(&crate::truth::Truth) -> Result<(), Halt>,
 ) -> Result<(), RunError> {
     match crate::run::run(scene, each, |_, _| {})? {
-        Ok(_) | Err(ReaderGone) => Ok(()),
+        Ok(_) | Err(Halt::ReaderGone) => Ok(()),
+        Err(Halt::Failed(e)) => Err(e),
     }
 }
 
