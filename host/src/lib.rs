@@ -1,53 +1,30 @@
-//! margemu host: simulates the 6-DOF test bench of Odry (2021), computes ground truth, and
-//! (in later layers) streams samples to the emulated chip and scores the device under test.
+//! margemu: the `margemu` command and the parts that need every layer beneath it. The
+//! libraries, bottom up:
 //!
-//! Layers, bottom up:
-//! - [`scene`]: the TOML scene file, validated with errors that point at file, line and column;
-//!   [`input_file`]: every file a scene reads is a regular file of bounded size;
-//! - [`reference`](mod@reference): each joint's reference signal (steps, waypoints, sines, random, CSV);
-//! - [`bench`](mod@bench): the closed-loop bench (eq. 5–17): joints, friction, PID synthesis, integrators;
-//! - [`motion`]: static, kinematic or bench motion, so a scene pays only for what it uses;
-//! - [`truth`]: ground truth of the plate (attitude, rates, specific force, field) per sample;
-//! - [`bus`]: embedded-hal 1.0 adapters (SPI, I2C, delay) that put the emulated chip under unmodified drivers;
-//! - [`marg`]: raw MARG samples from the shared `model` crate (eq. 18, perturbation eq. 19–23);
-//! - [`guard`]: the run stops at the first truth or sample value that is not finite;
-//! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `meta.toml`);
-//! - [`meta`]: the schema of `meta.toml`, written and read by the same types;
-//! - [`rundir`]: which directory a run writes to, and the completion record written last;
-//! - [`perf`]: speed-against-error benchmarks behind `margemu bench`;
-//! - [`loopback`]: the firmware's link handler behind a pseudo-terminal pair (the embedded default);
-//! - [`analysis`]: Allan deviation, PSD and their plots behind `margemu analyze`;
-//! - [`stream`]: real-time streaming of register images to a device over a serial port, with session logs;
-//! - [`evaluate`](mod@evaluate): scores of a device's or a filter's attitude against the truth (eq. 27, geodesic), aligned and split by phase.
-//! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port and logged;
-//! - [`offline`]: the reference filters (`margemu-filters`) run over recorded samples, estimates written;
-//! - [`tune`](mod@tune): a filter's parameters tuned on a scene over several seeds (Nelder–Mead, eq. 27);
-//! - [`vfc`]: a virtual flight controller on the loopback device (the chip's third-party driver, `mpu9250` or `icm426xx`, a reference filter, MAVLink out);
-//! - [`demo`]: the case study through loopback with the virtual flight controller (Table 3).
+//! - `margemu-sim` ([`scene`], [`bench`](mod@bench), [`truth`], [`marg`], [`run`], [`meta`],
+//!   [`rundir`], ...): a scene file to the bench, its ground truth, MARG samples and a run
+//!   directory;
+//! - `margemu-hil` ([`stream`], [`loopback`], [`bus`], [`dut`], [`vfc`]): real-time streaming to
+//!   an emulated chip and the device under test's output;
+//! - `margemu-eval` ([`evaluate`](mod@evaluate), [`analysis`], [`offline`], [`tune`](mod@tune)):
+//!   scores, noise analysis, offline filters and tuning.
+//!
+//! Each library's modules are re-exported here under their own names, so `margemu::scene` is
+//! `margemu_sim::scene`. This crate adds:
+//! - [`demo`]: the case study through loopback with the virtual flight controller (Table 3);
+//! - [`vfc_score`]: a virtual flight controller's session scored against the truth;
+//! - [`own_files`]: every file name margemu writes into a run or session directory;
+//! - [`perf`]: speed-against-error benchmarks behind `margemu bench`.
 #![warn(missing_docs)]
 
-pub mod analysis;
-pub mod bench;
-pub mod bus;
-pub mod csv_column;
-mod csv_table;
+pub use margemu_eval::{analysis, evaluate, offline, tune};
+pub use margemu_hil::{bus, dut, loopback, stream, vfc};
+pub use margemu_sim::{
+    bench, csv_column, filter_params, guard, input_file, marg, meta, motion, output, quat,
+    reference, run, rundir, scene, truth,
+};
+
 pub mod demo;
-pub mod dut;
-pub mod evaluate;
-pub mod guard;
-pub mod input_file;
-pub mod loopback;
-pub mod marg;
-pub mod meta;
-pub mod motion;
-pub mod offline;
-pub mod output;
+pub mod own_files;
 pub mod perf;
-pub mod reference;
-pub mod run;
-pub mod rundir;
-pub mod scene;
-pub mod stream;
-pub mod truth;
-pub mod tune;
-pub mod vfc;
+pub mod vfc_score;

@@ -11,12 +11,12 @@
 //! - [`link_table`]: worst-case link efficiency of image and kinematics batches, and the rates a
 //!   UART carries.
 
-use crate::reference::ReferenceError;
-use crate::run::for_each;
-use crate::scene::{Method, Scene};
-use crate::stream::{JitterStats, ServedStats, SourceMode, StreamConfig};
-use crate::truth::geodesic_angle;
+use margemu_hil::stream::{JitterStats, ServedStats, SourceMode, StreamConfig};
 use margemu_model::time::nanos_from_seconds;
+use margemu_sim::reference::ReferenceError;
+use margemu_sim::run::for_each;
+use margemu_sim::scene::{Method, Scene};
+use margemu_sim::truth::geodesic_angle;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -134,7 +134,7 @@ pub fn mode_costs(scenes: &[Scene], min_wall: Duration) -> Result<Vec<ModeRow>, 
 }
 
 /// One row of the streaming table: a scene streamed in real time through a PTY pair to the
-/// firmware's link handler ([`crate::loopback`]), checked against the prediction.
+/// firmware's link handler ([`margemu_hil::loopback`]), checked against the prediction.
 #[derive(Clone, Debug)]
 pub struct StreamRow {
     /// Output rate, Hz.
@@ -188,12 +188,12 @@ pub fn stream_sweep(
     sources: &[SourceMode],
     seconds: f64,
     dir: &std::path::Path,
-) -> Result<Vec<StreamRow>, crate::stream::StreamError> {
+) -> Result<Vec<StreamRow>, margemu_hil::stream::StreamError> {
     let mut rows = Vec::new();
     for &source in sources {
         for &rate_hz in rates {
             let mut scene = stream_scene(rate_hz, seconds);
-            scene.chip = crate::scene::chip::ChipSetup::power_on(chip);
+            scene.chip = margemu_sim::scene::chip::ChipSetup::power_on(chip);
             let mode = match source {
                 SourceMode::Images => "images",
                 SourceMode::Model { .. } => "model",
@@ -204,7 +204,7 @@ pub fn stream_sweep(
                 ..StreamConfig::default()
             };
             let session_dir = dir.join(format!("{mode}-{rate_hz}"));
-            let (result, device) = crate::loopback::run(&scene, config, &session_dir)?;
+            let (result, device) = margemu_hil::loopback::run(&scene, config, &session_dir)?;
             let summary = result.as_ref().ok();
             rows.push(StreamRow {
                 rate_hz,
@@ -268,7 +268,7 @@ pub fn link_table() -> Vec<LinkRow> {
                 chip: Some(chip),
                 items,
                 item_len: len,
-                wire_bytes: crate::stream::batch_wire_len(items, len, IMAGE_BATCH_HEADER_LEN),
+                wire_bytes: margemu_hil::stream::batch_wire_len(items, len, IMAGE_BATCH_HEADER_LEN),
             });
         }
     }
@@ -277,7 +277,7 @@ pub fn link_table() -> Vec<LinkRow> {
             chip: None,
             items,
             item_len: TRUTH_LEN,
-            wire_bytes: crate::stream::batch_wire_len(items, TRUTH_LEN, 8),
+            wire_bytes: margemu_hil::stream::batch_wire_len(items, TRUTH_LEN, 8),
         });
     }
     rows

@@ -69,7 +69,7 @@ fn run_scene(name: &str, scene: &Scene, config: VfcConfig) -> (VfcRun, PathBuf) 
 }
 
 fn evaluate(dir: &Path) -> Evaluation {
-    margemu::vfc::evaluate_session(dir).unwrap()
+    margemu::vfc_score::evaluate_session(dir).unwrap()
 }
 
 fn config(kind: FilterKind) -> VfcConfig {

@@ -53,6 +53,7 @@ impl OutputArgs {
             self.output.as_deref(),
             default,
             self.force,
+            margemu::own_files::OWN_FILES,
         )?)
     }
 }

@@ -72,8 +72,8 @@ pub struct DutArgs {
     /// session into dut_*.csv on the session's clock.
     #[arg(long, value_name = "PORT")]
     dut: Option<String>,
-    /// What the device under test speaks on --dut.
-    #[arg(long, value_enum, default_value_t = DutProtocol::Mavlink, requires = "dut")]
+    /// What the device under test speaks on --dut: mavlink or msp.
+    #[arg(long, value_name = "mavlink|msp", default_value_t = DutProtocol::Mavlink, requires = "dut")]
     dut_protocol: DutProtocol,
     /// Line rate of --dut (ignored by USB CDC and pseudo-terminals).
     #[arg(long, default_value_t = 115_200, requires = "dut")]

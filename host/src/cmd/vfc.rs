@@ -57,7 +57,7 @@ pub fn report(fc: &FcOutcome, dut: &DutSummary, dir: &Path) -> Result<()> {
         "every frame the flight controller sent was decoded ({} frames, {} bytes)",
         fc.uart.frames, fc.uart.bytes
     );
-    let eval = margemu::vfc::evaluate_session(dir)
+    let eval = margemu::vfc_score::evaluate_session(dir)
         .with_context(|| format!("evaluating {}", dir.display()))?;
     print!("{}", margemu::evaluate::report::summary(&eval));
     margemu::evaluate::report::write(&eval, dir, false)?;

@@ -1,6 +1,6 @@
 //! `margemu demo`: the paper's case study (section 3.2) end to end. The case-study scene streams
 //! in real time to the firmware device in loopback, with the virtual flight controller
-//! ([`crate::vfc`]) on its chip running each reference filter with its initial (default) and its
+//! ([`margemu_hil::vfc`]) on its chip running each reference filter with its initial (default) and its
 //! tuned parameters; the flight controller's MAVLink is read back through a second PTY pair and
 //! scored with `margemu evaluate`'s library. The result is the analogue of the paper's Table 3
 //! ([`table`]), with the paper's figures beside ours, and each run's session directory with its
@@ -11,16 +11,16 @@
 //! every epoch).
 //!
 //! **Tuned parameters** come from the caller ([`Tuned`]: a closure from the scene and the
-//! filter to [`FilterParams`]): `margemu demo` runs the tuner ([`crate::tune`]) in process on
+//! filter to [`FilterParams`]): `margemu demo` runs the tuner ([`margemu_eval::tune`]) in process on
 //! the scene, or reads a parameters file.
 
 pub mod table;
 
-use crate::evaluate::{EvalError, Scores};
-use crate::offline::{FilterKind, FilterParams};
-use crate::scene::{Scene, SceneError};
-use crate::stream::{Progress, StreamConfig};
-use crate::vfc::{run_loopback, FcReport, OutputRate, VfcConfig, VfcError};
+use margemu_eval::evaluate::{EvalError, Scores};
+use margemu_eval::offline::{FilterKind, FilterParams};
+use margemu_hil::stream::{Progress, StreamConfig};
+use margemu_hil::vfc::{run_loopback, FcReport, OutputRate, VfcConfig, VfcError};
+use margemu_sim::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -209,8 +209,8 @@ fn one(
         return Err(One::Run(why.clone()));
     }
     run.fc.check_delivery(&dut).map_err(One::Run)?;
-    let eval = crate::vfc::evaluate_session(dir).map_err(One::Evaluate)?;
-    crate::evaluate::report::write(&eval, dir, options.plots).map_err(One::Evaluate)?;
+    let eval = crate::vfc_score::evaluate_session(dir).map_err(One::Evaluate)?;
+    margemu_eval::evaluate::report::write(&eval, dir, options.plots).map_err(One::Evaluate)?;
     Ok(DemoRun {
         kind,
         variant,
@@ -226,10 +226,12 @@ fn one(
 /// How often the scene's true body rate exceeds the chip's gyro range (±2000 °/s, the widest
 /// the flight controller can set): `(samples with some axis beyond it, samples, largest |ω|
 /// component in rad/s)`.
-pub fn gyro_clipping(scene: &Scene) -> Result<(u64, u64, f64), crate::reference::ReferenceError> {
+pub fn gyro_clipping(
+    scene: &Scene,
+) -> Result<(u64, u64, f64), margemu_sim::reference::ReferenceError> {
     let limit = 2000f64.to_radians();
     let (mut over, mut n, mut max) = (0u64, 0u64, 0f64);
-    crate::run::for_each(scene, |t| {
+    margemu_sim::run::for_each(scene, |t| {
         let peak = t.body_rate.iter().fold(0f64, |m, w| m.max(w.abs()));
         max = max.max(peak);
         over += u64::from(peak > limit);

@@ -3,8 +3,8 @@
 //! paper does not give), as terminal text or Markdown.
 
 use super::{DemoRun, Variant};
-use crate::evaluate::Scores;
-use crate::offline::FilterKind;
+use margemu_eval::evaluate::Scores;
+use margemu_sim::filter_params::FilterKind;
 
 /// One row of the paper's Table 3 per filter: `[initial, tuned]`.
 struct PaperRow {

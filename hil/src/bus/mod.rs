@@ -1,0 +1,72 @@
+//! embedded-hal 1.0 adapters over the emulated chips' bus-target side, so third-party drivers
+//! run unmodified against [`margemu_firmware::chip`] on the host.
+//!
+//! The chips are driven byte by byte through [`SpiTarget`] and [`I2cTarget`]; these adapters
+//! play the controller:
+//!
+//! - [`SpiDevice`]: `embedded_hal::spi::SpiDevice`, chip select asserted for the whole
+//!   transaction (every [`Operation`](embedded_hal::spi::Operation) kind, `DelayNs` included);
+//! - [`SpiBus`] with its [`ChipSelect`] pin: `embedded_hal::spi::SpiBus` plus a
+//!   `digital::OutputPin`, for drivers that drive chip select themselves (or an
+//!   `ExclusiveDevice`-style pairing); MISO stays one byte ahead across separate bus calls;
+//! - [`I2c`]: `embedded_hal::i2c::I2c` with START, repeated START between operations of
+//!   different direction, STOP at the end, and NACKs reported as
+//!   [`NoAcknowledge`](embedded_hal::i2c::ErrorKind::NoAcknowledge) of the address or the data;
+//! - [`Delay`] and [`Clock`]: a `DelayNs` that never sleeps but, if given a clock, advances it
+//!   (drivers wait during their initialisation; the emulation decides what time means).
+//!
+//! **MISO one byte ahead.** [`SpiTarget::select`] returns the MISO byte of the first byte and
+//! [`SpiTarget::exchange`] the MISO byte of the *next* one, exactly as a target's shift
+//! register works; the adapters keep that pending byte, so byte *i* read by the controller is
+//! the one the target prepared while byte *i − 1* was clocked in.
+//!
+//! **Sharing.** Every adapter holds a [`Shared`] handle to its target (`Rc<RefCell<T>>`), so one
+//! chip can sit behind an SPI and an I2C adapter at once and the test bench can latch samples
+//! into it between driver calls. A handle already borrowed elsewhere makes the access fail
+//! with [`SpiError::TargetBusy`] or [`I2cError::TargetBusy`] instead of panicking.
+//!
+//! ```
+//! use embedded_hal::spi::SpiDevice as _;
+//! use margemu_hil::bus::{self, SpiDevice};
+//! use margemu_firmware::chip::SpiTarget;
+//!
+//! /// Echoes every MOSI byte on the following byte.
+//! struct Echo;
+//! impl SpiTarget for Echo {
+//!     fn select(&mut self) -> u8 { 0xA5 }
+//!     fn exchange(&mut self, mosi: u8) -> u8 { mosi }
+//!     fn deselect(&mut self) {}
+//! }
+//!
+//! let mut spi = SpiDevice::new(bus::shared(Echo));
+//! let mut buf = [1, 2, 3];
+//! spi.transfer_in_place(&mut buf).unwrap();
+//! assert_eq!(buf, [0xA5, 1, 2]);
+//! ```
+//!
+//! [`SpiTarget`]: margemu_firmware::chip::SpiTarget
+//! [`SpiTarget::select`]: margemu_firmware::chip::SpiTarget::select
+//! [`SpiTarget::exchange`]: margemu_firmware::chip::SpiTarget::exchange
+//! [`I2cTarget`]: margemu_firmware::chip::I2cTarget
+
+mod delay;
+mod i2c;
+mod spi;
+
+#[cfg(test)]
+mod fake;
+
+pub use delay::{Clock, Delay};
+pub use i2c::{I2c, I2cError};
+pub use spi::{ChipSelect, SpiBus, SpiDevice, SpiError};
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// A target shared between adapters and the test bench (host only, single-threaded).
+pub type Shared<T> = Rc<RefCell<T>>;
+
+/// Wraps `target` for sharing.
+pub fn shared<T>(target: T) -> Shared<T> {
+    Rc::new(RefCell::new(target))
+}

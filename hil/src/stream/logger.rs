@@ -1,0 +1,111 @@
+//! The session's log writer: a thread that owns the [`SessionLog`] files, so that a write the
+//! operating system holds up (a busy disk throttles writers for tens to hundreds of ms) never
+//! delays the pacing.
+//!
+//! The session queues jobs ([`Logger::write`]); the thread runs them in order and flushes every
+//! file whenever its queue runs empty, so rows reach the operating system within moments of
+//! being queued, and an interrupted session loses nothing that was queued: [`Logger::finish`]
+//! (also run on drop) writes the rest, flushes and reports the first error.
+//!
+//! The logger also holds the session's share of the directory's completion record
+//! ([`CompletionRecord`]): [`Logger::end`] sets it and lets go of it after the last row.
+
+use super::log::SessionLog;
+use margemu_sim::rundir::{Completion, CompletionRecord};
+use std::io;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{channel, Sender};
+use std::thread::JoinHandle;
+
+/// One queued write.
+type Job = Box<dyn FnOnce(&mut SessionLog) -> io::Result<()> + Send>;
+
+/// The handle on the writer thread.
+pub(super) struct Logger {
+    dir: PathBuf,
+    tx: Option<Sender<Job>>,
+    thread: Option<JoinHandle<io::Result<()>>>,
+    completion: Option<CompletionRecord>,
+}
+
+impl Logger {
+    /// Moves `log` to a new writer thread.
+    pub(super) fn spawn(mut log: SessionLog) -> io::Result<Self> {
+        let dir = log.dir().to_path_buf();
+        let completion = Some(CompletionRecord::new(&dir));
+        let (tx, rx) = channel::<Job>();
+        let thread = std::thread::Builder::new()
+            .name("margemu-log".into())
+            .spawn(move || {
+                while let Ok(job) = rx.recv() {
+                    job(&mut log)?;
+                    while let Ok(job) = rx.try_recv() {
+                        job(&mut log)?;
+                    }
+                    log.flush()?;
+                }
+                log.flush()
+            })?;
+        Ok(Self {
+            dir,
+            tx: Some(tx),
+            thread: Some(thread),
+            completion,
+        })
+    }
+
+    /// A share of the directory's completion record, for another writer of the directory (the
+    /// record is written when the last share is let go).
+    pub(super) fn completion(&self) -> Option<CompletionRecord> {
+        self.completion.clone()
+    }
+
+    /// Ends the writer (as [`Logger::finish`]), then records `completion` (failed instead if the
+    /// logs could not be written) and lets go of the logger's share of the record.
+    pub(super) fn end(&mut self, mut completion: Completion) -> io::Result<()> {
+        let finished = self.finish();
+        if let Err(e) = &finished {
+            completion.fail(format!("cannot write the logs: {e}"));
+        }
+        let Some(record) = self.completion.take() else {
+            return finished;
+        };
+        record.update(|c| *c = completion);
+        finished.and(record.release())
+    }
+
+    /// The session directory.
+    pub(super) fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Queues `job`; fails with the writer's error once a write has failed.
+    pub(super) fn write(
+        &mut self,
+        job: impl FnOnce(&mut SessionLog) -> io::Result<()> + Send + 'static,
+    ) -> io::Result<()> {
+        let sent = self.tx.as_ref().map(|tx| tx.send(Box::new(job)));
+        match sent {
+            Some(Ok(())) => Ok(()),
+            _ => self
+                .finish()
+                .and(Err(io::Error::other("the log writer has ended"))),
+        }
+    }
+
+    /// Writes what is queued, flushes, and ends the writer; returns its first error.
+    pub(super) fn finish(&mut self) -> io::Result<()> {
+        drop(self.tx.take());
+        match self.thread.take().map(JoinHandle::join) {
+            None => Ok(()),
+            Some(Ok(result)) => result,
+            Some(Err(_)) => Err(io::Error::other("the log writer panicked")),
+        }
+    }
+}
+
+impl Drop for Logger {
+    fn drop(&mut self) {
+        let _ = self.finish();
+    }
+}

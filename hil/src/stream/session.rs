@@ -1,0 +1,281 @@
+//! [`Session`]: the host side of one streaming run (handshake, configuration, prefill, paced
+//! batches, stop), over any byte port.
+
+use super::flow::Run;
+use super::images::{predict_images, ImageSettings};
+use super::log::{SessionLog, SENT_COLUMNS, SENT_KINEMATICS_COLUMNS};
+use super::logger::Logger;
+use super::meta::metadata;
+use super::model::predict_model;
+use super::rx;
+use super::source::{Items, Prediction};
+use super::{Progress, StreamError, Summary};
+use margemu_protocol::link::Rate;
+use margemu_sim::rundir::{Completion, CompletionRecord, Status};
+use margemu_sim::scene::chip::ChipSetup;
+use margemu_sim::scene::Scene;
+use std::io::{Read, Write};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Where the device's samples come from (`docs/spec/link.md` §5.3).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum SourceMode {
+    /// (a) The host sends every register image.
+    #[default]
+    Images,
+    /// (b) The host sends true kinematics and the device runs the shared sensor model
+    /// ([`predict_model`](super::predict_model)).
+    Model {
+        /// Kinematics rate, Hz: the output rate over a whole number; `None`: the default of
+        /// [`kinematics_hold`](super::kinematics_hold).
+        kinematics_hz: Option<f64>,
+    },
+}
+
+/// Settings of a streaming session. `Default` suits a board or a PTY at 1–8 kHz.
+#[derive(Clone, Debug)]
+pub struct StreamConfig {
+    /// The port's name, for `meta.toml`.
+    pub port: String,
+    /// The line rate, for `meta.toml` (a PTY or USB CDC ignores it).
+    pub baud: u32,
+    /// Physical → register conversion; `None`: [`ImageSettings::for_scene`].
+    pub images: Option<ImageSettings>,
+    /// Register images or the device's own model.
+    pub source: SourceMode,
+    /// How far ahead of its first sample's instant a batch is written (capped at 3/8 of the
+    /// device's buffer).
+    pub lead: Duration,
+    /// Most samples per batch (also capped by the device's `max_batch` and the frame size).
+    pub batch: usize,
+    /// Telemetry period asked of the device.
+    pub telemetry_period: Duration,
+    /// How long to wait for HelloAck and for the first credit window.
+    pub hello_timeout: Duration,
+    /// How long a due batch may wait for credit before the session gives up.
+    pub credit_timeout: Duration,
+    /// After the last sample's instant: how long to wait for the device to report it served,
+    /// and then for it to confirm Stop.
+    pub drain_timeout: Duration,
+    /// The last stretch before a send instant is busy-waited, for pacing precision.
+    pub spin: Duration,
+    /// The session number sent in Hello.
+    pub session_id: u32,
+    /// Go-back-N: how long after its last write an item the device reports lost (it holds items
+    /// after it) may be written again: the line's delivery time (a loaded machine's PTY can
+    /// take over 10 ms). Over a UART, add the line time of a batch (`margemu stream` does).
+    pub resend_after: Duration,
+}
+
+impl Default for StreamConfig {
+    fn default() -> Self {
+        Self {
+            port: String::new(),
+            baud: 921_600,
+            images: None,
+            source: SourceMode::Images,
+            lead: Duration::from_millis(200),
+            batch: 32,
+            telemetry_period: Duration::from_millis(20),
+            hello_timeout: Duration::from_secs(2),
+            credit_timeout: Duration::from_secs(2),
+            drain_timeout: Duration::from_secs(1),
+            spin: Duration::from_micros(200),
+            session_id: 0x6D61_7267, // "marg"
+            resend_after: Duration::from_millis(20),
+        }
+    }
+}
+
+/// One streaming run of one scene: its prediction (read lazily, a bounded window at a time),
+/// its settings and its log directory.
+pub struct Session {
+    pub(super) config: StreamConfig,
+    pub(super) settings: ImageSettings,
+    /// The chip Configure asks for (the scene's `[chip]`).
+    pub(super) chip: ChipSetup,
+    pub(super) rate: Rate,
+    /// Output samples in the scene.
+    pub(super) samples: u64,
+    pub(super) items: Items,
+    pub(super) prediction: Prediction,
+    pub(super) log: Logger,
+    pub(super) stop: Arc<AtomicBool>,
+    /// Host time 0 of the logs; `None`: when the run begins.
+    pub(super) origin: Option<Instant>,
+}
+
+impl Session {
+    /// Starts predicting the images of `scene` (in source mode model, after checking the device
+    /// can run it; the prediction runs lazily, a bounded window ahead of what is sent, so this
+    /// takes the same time and memory for any length of scene) and creates the session
+    /// directory `dir` (`meta.toml`, every file with its header). Nothing is sent yet.
+    pub fn new(scene: &Scene, config: StreamConfig, dir: &Path) -> Result<Self, StreamError> {
+        let settings = config
+            .images
+            .unwrap_or_else(|| ImageSettings::for_scene(scene));
+        let rate = rate_of(scene)?;
+        let (mut prediction, items, hold) = match config.source {
+            SourceMode::Images => (
+                Prediction::images(predict_images(scene, &settings)),
+                Items::Images,
+                None,
+            ),
+            SourceMode::Model { kinematics_hz } => {
+                let p = predict_model(scene, &settings, kinematics_hz)?;
+                let items = Items::Kinematics {
+                    params: Box::new(p.params),
+                    hold: p.hold,
+                };
+                (Prediction::model(p.samples), items, Some(p.hold))
+            }
+        };
+        prediction.check_start()?;
+        let meta = metadata(scene, &config, &settings, rate, hold);
+        let log_err = |source| StreamError::Log {
+            path: dir.to_path_buf(),
+            source,
+        };
+        let sent_columns = match items {
+            Items::Images => SENT_COLUMNS,
+            Items::Kinematics { .. } => SENT_KINEMATICS_COLUMNS,
+        };
+        let log = SessionLog::create(dir, &meta, sent_columns).map_err(log_err)?;
+        let log = Logger::spawn(log).map_err(log_err)?;
+        Ok(Self {
+            config,
+            settings,
+            chip: scene.chip,
+            rate,
+            samples: scene.samples(),
+            items,
+            prediction,
+            log,
+            stop: Arc::new(AtomicBool::new(false)),
+            origin: None,
+        })
+    }
+
+    /// Setting this flag (e.g. from a Ctrl-C handler) stops the session: it sends Stop, flushes
+    /// the logs and returns [`StreamError::Interrupted`].
+    pub fn stop_flag(&self) -> Arc<AtomicBool> {
+        self.stop.clone()
+    }
+
+    /// Makes `origin` host time 0 of the logs (every `host_ns`, `start_host_ns`) instead of the
+    /// moment the run begins, so that another logger (the device under test's reader,
+    /// [`crate::dut`]) can share the session's clock.
+    pub fn set_origin(&mut self, origin: Instant) {
+        self.origin = Some(origin);
+    }
+
+    /// A share of the session directory's completion record ([`margemu_sim::rundir`]), for a writer
+    /// that logs into the directory beside the session (the device under test's reader): the
+    /// record is written to `meta.toml` when the session has ended and every share is let go.
+    pub fn completion_record(&self) -> Option<CompletionRecord> {
+        self.log.completion()
+    }
+
+    /// Output samples in the scene (their images: [`predict_images`](super::predict_images)
+    /// with [`Session::image_settings`]).
+    pub fn sample_count(&self) -> u64 {
+        self.samples
+    }
+
+    /// The register settings the images were computed with.
+    pub fn image_settings(&self) -> &ImageSettings {
+        &self.settings
+    }
+
+    /// Runs the session on a serial port (a clone of it feeds the receive thread).
+    pub fn run_on_port(
+        self,
+        port: serialport::TTYPort,
+        progress: impl FnMut(&Progress),
+    ) -> Result<Summary, StreamError> {
+        let reader = port
+            .try_clone_native()
+            .map_err(|e| StreamError::Port { source: e.into() })?;
+        self.run(reader, port, progress)
+    }
+
+    /// Runs the session: `reader` and `writer` are the two directions of the port (`reader` must
+    /// return from `read` now and then, by data, timeout or end of file). `progress` is called
+    /// about ten times a second. Whatever the outcome, the logs are flushed, `events.csv` ends
+    /// with an `end` row saying how the session ended, and `meta.toml` gets its completion
+    /// record (complete, interrupted or failed; [`margemu_sim::rundir`]) once every other writer of
+    /// the directory has let go of its share ([`Session::completion_record`]).
+    pub fn run(
+        mut self,
+        reader: impl Read + Send + 'static,
+        writer: impl Write,
+        progress: impl FnMut(&Progress),
+    ) -> Result<Summary, StreamError> {
+        let shutdown = Arc::new(AtomicBool::new(false));
+        let (events, _thread) = rx::spawn(reader, shutdown.clone());
+        let mut run = Run::new(&mut self, writer, events, progress);
+        let result = run.session_flow();
+        let end_ns = run.host_ns(Instant::now());
+        let summary = run.summary();
+        drop(run);
+        shutdown.store(true, Ordering::Relaxed);
+        let (status, ended) = match &result {
+            Ok(()) => (Status::Complete, "completed".to_string()),
+            Err(e @ StreamError::Interrupted) => (Status::Interrupted, e.to_string()),
+            Err(e) => (Status::Failed, e.to_string()),
+        };
+        let detail = match status {
+            Status::Complete => ended.clone(),
+            _ => format!("error: {ended}"),
+        };
+        let served = &summary.served;
+        let completion = Completion {
+            status,
+            samples_written: served.samples - served.unreported,
+            samples_expected: Some(served.samples),
+            ended,
+        };
+        let logged = self
+            .log
+            .write(move |log| log.event(end_ns, "end", &detail))
+            .and_then(|()| self.log.end(completion));
+        result?;
+        logged.map_err(|source| StreamError::Log {
+            path: self.log.dir().to_path_buf(),
+            source,
+        })?;
+        Ok(summary)
+    }
+}
+
+/// The scene's output rate as the link's exact ratio, checked against the scene clock.
+pub fn rate_of(scene: &Scene) -> Result<Rate, StreamError> {
+    let hz = scene.clock.hz();
+    let mhz = (hz * 1000.0).round() as u64;
+    let g = gcd(mhz, 1000);
+    let rate = u32::try_from(mhz / g)
+        .ok()
+        .and_then(|num| Rate::new(num, (1000 / g) as u32));
+    let total = scene.samples();
+    match rate {
+        Some(rate)
+            if [1, 2, 3, 7, total.saturating_sub(1), total]
+                .iter()
+                .all(|&k| rate.sample_time_ns(k) == scene.clock.instant(k)) =>
+        {
+            Ok(rate)
+        }
+        _ => Err(StreamError::Rate { hz }),
+    }
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}

@@ -1,0 +1,381 @@
+//! [`VirtualFc`]: the flight controller's main loop, run at every turn of the loopback device's
+//! loop ([`crate::loopback::spawn_device_with_local`]) with the firmware `Device` it sits on.
+//!
+//! 1. While the device is idle there is nothing to do. Once it is configured (the chip of the
+//!    session exists), the board of the chip's model sets the chip up through its driver
+//!    ([`Board::init`]) and checks that the chip now converts samples the way the host
+//!    predicted its images; a mismatch ends the device loop with the reason (the session then
+//!    fails with it). A new Hello (the device back to idle) starts over.
+//! 2. At each turn, the INT pin: when it says data ready, the driver reads what is waiting
+//!    (clearing INT): one sample on the MPU-9250, every FIFO packet on the ICM-42688-P. The
+//!    board turns each into SI body axes ([`Board::to_body`]), and the filter takes it with
+//!    `dt` = the time since the previous sample's data-ready edge. On a chip with a
+//!    magnetometer the filter starts with the first sample that carries a measurement (the
+//!    AK8963 delivers its first one a period of its own after set-up; a start without it would
+//!    take yaw 0); the samples before are counted as warm-up.
+//!
+//! **Without a magnetometer** (ICM-42688-P) the filter gets a zero field with every sample. The
+//! filters of `margemu-filters` take that as an unusable magnetometer: they skip the
+//! magnetometer correction and count it (`skipped_mag`, one per sample), and the first sample
+//! sets the tilt only, at yaw 0 (TRIAD without a field). So the heading reported is the one the
+//! filters have without a magnetometer: 0 at the first sample, then the integrated gyroscope
+//! (the EKF's bias estimate is then driven by gravity alone, which does not observe the bias
+//! about the vertical). Roll and pitch are corrected by the accelerometer as with a
+//! magnetometer; the yaw error is the truth's heading at the first sample plus the drift, so
+//! compare roll and pitch (a geodesic score includes the yaw error).
+//! 3. The output: at the configured rate on the device clock, or after every sample, an
+//!    ATTITUDE and an ATTITUDE_QUATERNION (MAVLink 2, [`crate::dut::mavlink_out`]) with `time_boot_ms` =
+//!    the sample's instant; a HEARTBEAT every second. Frames go to the UART queue.
+//!
+//! **Time.** The flight controller's clock is the device's scene clock: a data-ready edge
+//! happens when the device latches a sample, at that sample's scene instant
+//! ([`Device::last_served`](margemu_firmware::link::Device::last_served)), which is what an edge
+//! interrupt would timestamp. The loop polls the pin, so reads come up to one turn (about 1 ms)
+//! after the edge; when the host starves the device thread for longer than a sample period, a
+//! sample latched over before it was read is lost to the flight controller, as on a board that
+//! misses an interrupt, and counted in [`FcReport::missed`] (the filter's `dt` spans the gap).
+//! A FIFO keeps such samples: the newest packet read is the last sample served, each older one
+//! a sample period earlier. Only a FIFO overflow (flushed, [`FcReport::overflows`]) loses them.
+
+use super::axes::BodySample;
+use super::board::{self, Board};
+use super::uart::UartTx;
+use super::{OutputRate, VfcConfig};
+use crate::dut::mavlink_out::{attitude, attitude_quaternion, MavlinkWriter};
+use crate::loopback::Firmware;
+use margemu_filters::{AttitudeFilter, Diagnostics, Imu, Initial};
+use margemu_firmware::chip::EmulatedChip;
+use margemu_protocol::chip::ChipSettings;
+use margemu_protocol::link::DeviceState;
+use margemu_sim::filter_params::ParamError;
+use mavlink::dialects::common::{
+    MavAutopilot, MavMessage, MavModeFlag, MavState, MavType, HEARTBEAT_DATA,
+};
+use std::collections::BTreeMap;
+use std::ops::ControlFlow;
+use std::sync::{Arc, Mutex};
+
+/// What the flight controller did (shared with the caller while it runs).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FcReport {
+    /// The filter and its parameters.
+    pub filter: String,
+    /// The bus the driver used (`SPI` or `I2C`).
+    pub bus: &'static str,
+    /// What the board's driver did at set-up (the last set-up, if the device was configured
+    /// again).
+    pub setup: Option<board::Setup>,
+    /// What the `mpu9250` driver found at set-up, on an MPU-9250 ([`board::Setup::mpu9250`]).
+    pub init: Option<board::InitReport>,
+    /// Set-ups done.
+    pub inits: u64,
+    /// Samples read on data ready.
+    pub samples: u64,
+    /// Samples read before the first magnetometer measurement (not filtered; chips with a
+    /// magnetometer only).
+    pub warmup: u64,
+    /// Samples never read: latched over by the next one before the flight controller saw its
+    /// data-ready, or flushed with an overflowing FIFO (from the gaps between the instants of
+    /// the samples read).
+    pub missed: u64,
+    /// FIFO overflows (each flushed the FIFO).
+    pub overflows: u64,
+    /// Frames queued per MAVLink message name.
+    pub sent: BTreeMap<&'static str, u64>,
+    /// Frames dropped because the UART queue was full.
+    pub dropped: u64,
+    /// The filter's counters.
+    pub diagnostics: Diagnostics,
+    /// Why the flight controller stopped the device loop, if it did.
+    pub error: Option<String>,
+}
+
+impl FcReport {
+    /// Frames queued, all messages.
+    pub fn frames(&self) -> u64 {
+        self.sent.values().sum()
+    }
+}
+
+/// The flight controller: board, filter, output schedule, telemetry.
+pub struct VirtualFc {
+    config: VfcConfig,
+    expected: ChipSettings,
+    board: Option<Board>,
+    filter: Box<dyn AttitudeFilter<f64> + Send>,
+    /// Instant of the previous sample filtered, ns.
+    last_ns: Option<u64>,
+    /// Instant of the previous sample read, ns.
+    last_read_ns: Option<u64>,
+    /// Index of the next output instant (for [`OutputRate::Hz`]).
+    next_out: u64,
+    next_heartbeat_ns: u64,
+    mavlink: MavlinkWriter,
+    uart: UartTx,
+    report: Arc<Mutex<FcReport>>,
+}
+
+impl VirtualFc {
+    /// A flight controller of `config` that has not seen its chip yet; `expected` is the
+    /// conversion the host predicted images with; frames go to `uart`; `report` is kept up to
+    /// date.
+    pub fn new(
+        config: VfcConfig,
+        expected: ChipSettings,
+        uart: UartTx,
+        report: Arc<Mutex<FcReport>>,
+    ) -> Result<Self, ParamError> {
+        let filter = config
+            .filter
+            .build(config.mag_reference, Initial::FirstSample)?;
+        {
+            let mut r = report.lock().unwrap_or_else(|e| e.into_inner());
+            r.filter = format!(
+                "{} ({})",
+                config.filter.kind(),
+                super::describe(&config.filter)
+            );
+            r.bus = board::bus(expected.model).unwrap_or("no bus");
+        }
+        Ok(Self {
+            config,
+            expected,
+            board: None,
+            filter,
+            last_ns: None,
+            last_read_ns: None,
+            next_out: 0,
+            next_heartbeat_ns: 0,
+            mavlink: MavlinkWriter::v2(),
+            uart,
+            report,
+        })
+    }
+
+    /// One turn of the main loop (see the module docs); `Break` ends the device loop.
+    pub fn step(&mut self, device: &mut Firmware, _now_ns: u64) -> ControlFlow<String> {
+        let result = self.turn(device);
+        if let Err(why) = &result {
+            self.update(|r| r.error = Some(why.clone()));
+        }
+        match result {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(why) => ControlFlow::Break(format!("virtual flight controller: {why}")),
+        }
+    }
+
+    fn turn(&mut self, device: &mut Firmware) -> Result<(), String> {
+        if device.state() == DeviceState::Idle {
+            self.board = None;
+            return Ok(());
+        }
+        if self.board.is_none() {
+            let board = self.set_up(device)?;
+            self.board = Some(board);
+        }
+        let Some(board) = &mut self.board else {
+            return Ok(());
+        };
+        let t_ns = device.last_served().map_or(0, |s| s.time_ns);
+        let chip: &mut EmulatedChip = device.chip_mut();
+        if !board.data_ready(chip)? {
+            return Ok(());
+        }
+        let readings = board
+            .read(chip)
+            .map_err(|e| format!("reading the chip: {e}"))?;
+        let overflows = board.overflows();
+        let with_mag = board.has_magnetometer();
+        let bodies: Vec<BodySample> = readings
+            .iter()
+            .map(|r| board.to_body(r, &self.config.mag_alignment))
+            .collect();
+        self.update(|r| r.overflows = overflows);
+        let period_ns = 1e9 / self.config.sample_rate_hz;
+        let n = bodies.len();
+        for (i, body) in bodies.into_iter().enumerate() {
+            // The newest sample read is the last one served; a FIFO's older ones came a
+            // period apart before it.
+            let back_ns = ((n - 1 - i) as f64 * period_ns).round() as u64;
+            self.take(t_ns.saturating_sub(back_ns), body, with_mag);
+        }
+        Ok(())
+    }
+
+    /// One sample read, at the instant `t_ns`: counted, then filtered and sent.
+    fn take(&mut self, t_ns: u64, body: BodySample, with_mag: bool) {
+        let period_ns = 1e9 / self.config.sample_rate_hz;
+        // Samples since the previous read (the first instant of the device clock is 0).
+        let gap_ns = match self.last_read_ns {
+            Some(last) => t_ns.saturating_sub(last) as f64,
+            None => t_ns as f64 + period_ns,
+        };
+        self.last_read_ns = Some(t_ns);
+        let missed = ((gap_ns / period_ns).round() as u64).saturating_sub(1);
+        let warmup = with_mag && self.last_ns.is_none() && body.mag_ut == [0.0; 3];
+        self.update(|r| {
+            r.samples += 1;
+            r.missed += missed;
+            r.warmup += u64::from(warmup);
+        });
+        if warmup {
+            return;
+        }
+        let dt_ns = match self.last_ns {
+            Some(last) => t_ns.saturating_sub(last) as f64,
+            None => period_ns,
+        };
+        self.last_ns = Some(t_ns);
+        let imu = Imu {
+            gyro: body.gyro,
+            acc: body.acc,
+            mag: body.mag_ut,
+        };
+        self.filter.update(&imu, dt_ns * 1e-9);
+        let diagnostics = self.filter.diagnostics();
+        self.update(|r| r.diagnostics = diagnostics);
+        self.output(t_ns, body.gyro);
+    }
+
+    /// Sets the device's chip up and checks its conversion against the host's prediction.
+    fn set_up(&mut self, device: &mut Firmware) -> Result<Board, String> {
+        let (board, setup) = Board::init(device.chip_mut(), self.config.sample_rate_hz)?;
+        let configured = setup.configured;
+        if configured.model != self.expected.model {
+            return Err(format!(
+                "the board set up a {:?}, but the host computed its images for a {:?}",
+                configured.model, self.expected.model
+            ));
+        }
+        if configured != self.expected {
+            return Err(format!(
+                "the driver configured the chip as {:?}, but the host computed its images for {:?}",
+                configured.conversion, self.expected.conversion
+            ));
+        }
+        self.filter = self
+            .config
+            .filter
+            .build(self.config.mag_reference, Initial::FirstSample)
+            .map_err(|e| e.to_string())?;
+        self.last_ns = None;
+        self.last_read_ns = None;
+        self.next_out = 0;
+        self.next_heartbeat_ns = 0;
+        self.update(|r| {
+            r.init = setup.mpu9250;
+            r.setup = Some(setup);
+            r.inits += 1;
+        });
+        Ok(board)
+    }
+
+    /// Sends what is due at the sample instant `t_ns`.
+    fn output(&mut self, t_ns: u64, body_rate: [f64; 3]) {
+        if t_ns >= self.next_heartbeat_ns {
+            self.next_heartbeat_ns = t_ns + 1_000_000_000;
+            self.send("HEARTBEAT", &heartbeat());
+        }
+        let due = match self.config.output {
+            OutputRate::EverySample => true,
+            OutputRate::Hz(hz) => {
+                let instant = |k: u64| (k as f64 * 1e9 / hz).floor() as u64;
+                let due = t_ns >= instant(self.next_out);
+                while instant(self.next_out) <= t_ns {
+                    self.next_out += 1;
+                }
+                due
+            }
+        };
+        if due {
+            let q = self.filter.quaternion();
+            let ms = u32::try_from(t_ns / 1_000_000).unwrap_or(u32::MAX);
+            self.send("ATTITUDE", &attitude(ms, q, body_rate));
+            self.send(
+                "ATTITUDE_QUATERNION",
+                &attitude_quaternion(ms, q, body_rate),
+            );
+        }
+    }
+
+    fn send(&mut self, name: &'static str, message: &MavMessage) {
+        // MAVLink 2 carries every common message: encoding cannot fail.
+        let Ok(frame) = self.mavlink.encode(message) else {
+            return;
+        };
+        let queued = self.uart.send(frame);
+        let dropped = self.uart.dropped();
+        self.update(|r| {
+            if queued {
+                *r.sent.entry(name).or_default() += 1;
+            }
+            r.dropped = dropped;
+        });
+    }
+
+    fn update(&self, f: impl FnOnce(&mut FcReport)) {
+        f(&mut self.report.lock().unwrap_or_else(|e| e.into_inner()));
+    }
+}
+
+fn heartbeat() -> MavMessage {
+    MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        custom_mode: 0,
+        mavtype: MavType::MAV_TYPE_QUADROTOR,
+        autopilot: MavAutopilot::MAV_AUTOPILOT_GENERIC,
+        base_mode: MavModeFlag::empty(),
+        system_status: MavState::MAV_STATE_ACTIVE,
+        mavlink_version: 3,
+    })
+}
+
+/// `ecf (kp = 0.5, ki = 0) over SPI: WHO_AM_I 0x71, AK8963 0x48; 600 samples (0 late); sent
+/// ATTITUDE 150, …; 0 dropped; filter: 0 skipped updates, 0 skipped accel, 0 skipped mag, 0
+/// rejected`.
+impl std::fmt::Display for FcReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} over {}: ", self.filter, self.bus)?;
+        match (&self.init, &self.setup) {
+            (Some(i), _) => write!(
+                f,
+                "WHO_AM_I {:#04x}, AK8963 {:#04x}",
+                i.who_am_i, i.ak8963_wia
+            )?,
+            (None, Some(s)) => write!(
+                f,
+                "{} WHO_AM_I {:#04x}{}",
+                s.model.part_name(),
+                s.who_am_i,
+                if s.model.has_magnetometer() {
+                    ""
+                } else {
+                    ", no magnetometer (heading from the gyroscope alone)"
+                }
+            )?,
+            (None, None) => f.write_str("chip never set up")?,
+        }
+        let sent: Vec<String> = self.sent.iter().map(|(m, n)| format!("{m} {n}")).collect();
+        let d = &self.diagnostics;
+        write!(
+            f,
+            "; {} samples read ({} warm-up), {} missed{}; sent {}; {} dropped; filter: {} skipped updates, {} skipped accel, {} skipped mag, {} rejected",
+            self.samples,
+            self.warmup,
+            self.missed,
+            match self.overflows {
+                0 => String::new(),
+                n => format!(" ({n} FIFO overflows)"),
+            },
+            if sent.is_empty() { "nothing".into() } else { sent.join(", ") },
+            self.dropped,
+            d.skipped_updates,
+            d.skipped_accel,
+            d.skipped_mag,
+            d.rejected
+        )?;
+        if let Some(e) = &self.error {
+            write!(f, "; stopped: {e}")?;
+        }
+        Ok(())
+    }
+}
