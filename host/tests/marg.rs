@@ -174,6 +174,10 @@ fn bad_sensor_sections_are_located() {
         ("[perturbation]\namplitude = [0.0, 0.0]\n", "5:13", "amplitude range is zero"),
         ("[perturbation]\nplacement = \"direction\"\n", "5:13", "needs `direction = [x, y, z]`"),
         ("[sensors.mag]\nsoft_iron = [[1, 0], [0, 1], [0, 0]]\n", "5:14", "invalid length 2"),
+        ("[sensors.gyro]\nbias = [0.1, 0.0]\n", "5:8", "invalid length 2, expected an array of length 3"),
+        ("[sensors.accel]\nnoise = [0.1, 0.0, 0.0]\n", "5:1", "unknown field `noise`, expected one of `scale_factor`, `misalignment`, `bias`, `noise_density`, `bias_instability`, `rate_random_walk`, `temperature_bias`, `resolution`, `range`, `g_sensitivity`, `lever_arm`, `soft_iron`, `hard_iron`"),
+        ("[sensors.mag]\ntemperature_bias = { coefficient = [1, 1, 1] }\n", "5:20", "missing field `reference`"),
+        ("[sensors.gyro]\nbias_instability = { coefficient = [1, 1, 1], correlation_time_s = 1.0 }\n", "5:47", "unknown field `correlation_time_s`"),
     ];
     for (section, place, reason) in cases {
         let err = Scene::parse_str(&format!("{base}{section}"), Path::new("s.toml"))

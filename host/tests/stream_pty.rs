@@ -8,9 +8,10 @@ mod common;
 
 use common::{assert_logs_valid, config, read_csv, scene, scratch};
 use margemu::loopback::{spawn_device, spawn_device_with, Firmware};
-use margemu::stream::{parse_image_hex, predict_images, Session, StreamConfig, StreamError};
+use margemu::stream::{predict_images, Session, StreamConfig, StreamError};
 use margemu_firmware::chip::SpiTarget;
 use margemu_firmware::link::{Device, Identity};
+use margemu_protocol::chip::Image;
 use margemu_protocol::link::{
     Accumulator, DeviceState, Encoder, FeedResult, FrameRepr, HelloAck, Message, ResetCause,
     MAX_WIRE_LEN,
@@ -84,7 +85,7 @@ fn a_short_scene_streams_end_to_end_byte_for_byte() {
         assert_eq!(row[1], truth[k][0], "t_ns of sample {k}");
         row[2].parse::<i64>().unwrap();
         assert!(row[3].is_empty() || row[3].parse::<i64>().is_ok());
-        assert_eq!(parse_image_hex(&row[4], 22), Some(predicted[k]));
+        assert_eq!(Image::parse_hex(&row[4], 22), Some(predicted[k]));
     }
     let (_, served) = read_csv(&dir, "served.csv");
     assert!(served.len() >= 1000);
@@ -135,7 +136,7 @@ fn a_device_that_vanishes_stops_the_session_with_valid_logs() {
     );
     let (_, sent) = read_csv(&dir, "sent.csv");
     assert!(sent.len() >= 300 && sent.len() < 2000, "{}", sent.len());
-    assert!(sent.iter().all(|r| parse_image_hex(&r[4], 22).is_some()));
+    assert!(sent.iter().all(|r| Image::parse_hex(&r[4], 22).is_some()));
     let served = common::served(&dir, 2000);
     assert!(served.len() >= 250, "{}", served.len());
     assert!(served.iter().all(|&(_, underrun, ok)| ok && !underrun));

@@ -16,7 +16,6 @@
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `marg.csv`);
 //! - [`meta`]: the schema of `meta.toml`, written and read by the same types;
 //! - [`rundir`]: which directory a run writes to, and the completion record written last;
-//! - [`image_hex`]: register images as the logs write them;
 //! - [`quat`]: attitude quaternions as the logs and scores use them (normalisation, Euler
 //!   angles, geodesic distance, interpolation);
 //! - [`filter_params`]: which reference filter runs with which parameters, and their file
@@ -28,7 +27,6 @@ pub mod csv_column;
 pub mod csv_table;
 pub mod filter_params;
 pub mod guard;
-pub mod image_hex;
 pub mod input_file;
 pub mod marg;
 pub mod meta;

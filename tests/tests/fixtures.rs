@@ -193,6 +193,6 @@ fn the_guides_full_scene_example_is_a_valid_scene() {
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert!(scene.spec.perturbation.is_some());
-    assert!(scene.spec.sensors.gyro.noise_density.is_some());
+    assert!(scene.spec.sensors.gyro.errors.noise_density.is_some());
     assert_eq!(truths(&scene).len() as u64, scene.samples());
 }

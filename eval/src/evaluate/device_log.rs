@@ -13,12 +13,11 @@
 //! m/s², the field in the scene's unit (µT ÷ `mag_ut_per_unit`), both in the chip's axes. What
 //! the chip clipped stays clipped: the plots show what the device under test was given.
 
-use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion, FullScale};
+use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion, FullScale, Image};
 use margemu_protocol::regmap::ak8963::MagBits;
 use margemu_protocol::regmap::mpu6xxx::AccelFs;
 use margemu_sim::csv_column::ColumnError;
 use margemu_sim::csv_table::Table;
-use margemu_sim::image_hex::parse_image_hex;
 use margemu_sim::meta::{ForeignMeta, MetaFile};
 use std::path::{Path, PathBuf};
 
@@ -169,7 +168,7 @@ pub fn read_sent(path: &Path, meta: &SessionMeta) -> Result<super::input::Imu, C
         row.check_order(t, imu.t_ns.last().copied(), t_ns, true)?;
         let text = row.text(image);
         let len = meta.chip.model.image_len();
-        let decoded = parse_image_hex(text, len).and_then(|bytes| decode(&bytes, meta));
+        let decoded = Image::parse_hex(text, len).and_then(|bytes| decode(&bytes, meta));
         let Some((acc, mag)) = decoded else {
             return Err(row.error(format!("`image` = {text:?} is not {} hex digits", 2 * len)));
         };

@@ -251,3 +251,40 @@ impl Chip for EmulatedChip {
         each_chip!(self, c => c.i2c_addresses_now())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every emulated chip holds its chip module's power-on settings right after power-on, under
+    /// each of its identities and addresses, and reaches the settings `config_writes` stands
+    /// for through those writes: the host reads both from the chip module, never from a chip.
+    #[test]
+    fn power_on_settings_are_the_chip_modules() {
+        use margemu_protocol::chip::FullScale;
+        assert_eq!(
+            EmulatedChip::default().settings(),
+            ChipSettings::power_on(ChipModel::Mpu9250)
+        );
+        for model in EmulatedChip::models() {
+            for &who_am_i in model.identities() {
+                for &address in model.i2c_addresses() {
+                    let chip = EmulatedChip::new(model, who_am_i, address).unwrap();
+                    let at = (model, who_am_i, address);
+                    assert_eq!(chip.settings(), ChipSettings::power_on(model), "{at:?}");
+                }
+            }
+            let fs = FullScale {
+                accel_g: 16.0,
+                gyro_dps: 2000.0,
+            };
+            let want = ChipSettings::with_full_scale(model, fs).unwrap();
+            let mut chip =
+                EmulatedChip::new(model, model.who_am_i(), model.i2c_addresses()[0]).unwrap();
+            for (file, register, value) in want.config_writes(1000.0) {
+                assert!(chip.write_register(file, register, value), "{model:?}");
+            }
+            assert_eq!(chip.settings(), want, "{model:?} at ±16 g, ±2000 °/s");
+        }
+    }
+}

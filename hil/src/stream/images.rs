@@ -26,7 +26,6 @@
 use super::predictor::{run_scene, Halt, Predictions};
 use margemu_protocol::chip::{ChipSettings, PhysicalSample};
 use margemu_protocol::link::Image;
-pub use margemu_sim::image_hex::{image_hex, parse_image_hex};
 use margemu_sim::marg::MargSim;
 use margemu_sim::scene::chip::ChipSetup;
 use margemu_sim::scene::{FieldUnit, Scene};

@@ -10,7 +10,7 @@
 //! | file | columns |
 //! |---|---|
 //! | `truth.csv` | as `simulate` writes it (`docs/ground-truth.md`), one row per sample, written as the session predicts them (in order, a window ahead of what it sends): every sample of the scene once the session completes |
-//! | `sent.csv` | one row per item written, in the order written. Source images: `index,t_ns,send_ns,late_ns,image,resend`: sample index, its latch instant, when the write of its batch to the port completed, how late that was against the batch's schedule `start_host_ns + t_ns − lead` of its first sample (empty for the prefill, written before Start, and for resends), the 22-byte register image as 44 lowercase hex digits, and `1` if the item was written again because the device had not received it (go-back-N; `0` for the first copy). Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend`: the kinematics sample's index and instant at the kinematics rate, the same times, the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip, and the resend flag |
+//! | `sent.csv` | one row per item written, in the order written. Source images: `index,t_ns,send_ns,late_ns,image,resend`: sample index, its latch instant, when the write of its batch to the port completed, how late that was against the batch's schedule `start_host_ns + t_ns − lead` of its first sample (empty for the prefill, written before Start, and for resends), the register image as two lowercase hex digits per byte (`Image`'s `{:x}`, read back by `Image::parse_hex`; 44 digits for the 22-byte MPU-9250 image), and `1` if the item was written again because the device had not received it (go-back-N; `0` for the first copy). Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend`: the kinematics sample's index and instant at the kinematics rate, the same times, the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip, and the resend flag |
 //! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample and for entries the check cannot verify (see `served.rs`) |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
@@ -29,8 +29,6 @@ use margemu_sim::truth::Truth;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
-
-use super::images::image_hex;
 
 /// `sent.csv`.
 pub const SENT_FILE: &str = "sent.csv";
@@ -143,7 +141,7 @@ impl SessionLog {
         resend: bool,
     ) -> io::Result<()> {
         self.sent_times(index, t_ns, send_ns, late_ns)?;
-        writeln!(self.sent, ",{},{}", image_hex(image), u8::from(resend))
+        writeln!(self.sent, ",{image:x},{}", u8::from(resend))
     }
 
     /// One row of `sent.csv` in source mode model.

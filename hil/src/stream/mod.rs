@@ -56,7 +56,7 @@ mod session;
 mod source;
 pub mod window;
 
-pub use images::{image_hex, parse_image_hex, predict_images, ImageSettings, PredictedSample};
+pub use images::{predict_images, ImageSettings, PredictedSample};
 pub use lateness::Lateness;
 pub use model::{
     device_chip, kinematics_hold, model_images, predict_model, ModelPrediction, ModelSample,

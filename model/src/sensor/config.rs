@@ -1,4 +1,7 @@
-//! Plain configuration structs of the sensor model, in SI units, every term optional.
+//! Plain configuration structs of the sensor model, in SI units, every term optional: the one
+//! definition of the sensor configuration. A scene's `[sensors.*]` tables are read into
+//! [`SensorTable`]s (with the `serde` feature) and the link carries [`MargConfig`] itself
+//! (`margemu_protocol`'s model terms encoding).
 //!
 //! Each struct derives `Default` with every term `None`, which is the ideal sensor; a scene names
 //! only the terms it wants. Values are `f64` (as a TOML scene parses them); the constructors
@@ -42,21 +45,35 @@ pub struct SensorErrors {
     pub range: Option<[f64; 3]>,
 }
 
-/// Bias instability as a first-order Gauss–Markov process (see [`crate::noise`]).
+/// Bias instability as a first-order Gauss–Markov process (see [`crate::noise`]); a scene
+/// writes it `{ coefficient = [..], correlation_time = .. }`.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct BiasInstability {
     /// IEEE Std 952 bias-instability coefficient B per axis, unit; the Allan floor is `0.664·B`.
     pub coefficient: [f64; 3],
     /// Correlation time of the process, s (> 0); the floor shows around τ = 1.89 × this.
+    #[cfg_attr(feature = "serde", serde(rename = "correlation_time"))]
     pub correlation_time_s: f64,
 }
 
-/// A bias linear in temperature: `coefficient · (T − reference_c)`.
+/// A bias linear in temperature: `coefficient · (T − reference_c)`; a scene writes it
+/// `{ coefficient = [..], reference = .. }`.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct TemperatureBias {
     /// Bias per degree, unit/°C.
     pub coefficient: [f64; 3],
     /// Temperature at which the term is zero, °C.
+    #[cfg_attr(feature = "serde", serde(rename = "reference"))]
     pub reference_c: f64,
 }
 
@@ -106,5 +123,77 @@ impl SensorErrors {
     /// Whether no term is configured (the sensor is ideal).
     pub fn is_ideal(&self) -> bool {
         *self == Self::default()
+    }
+}
+
+/// One sensor's terms as a scene writes them, in one `[sensors.<gyro|accel|mag>]` table: the
+/// shared [`SensorErrors`] and every sensor-specific term, whichever sensor it belongs to, so
+/// the reader can say where a misplaced term is ([`SensorTable::foreign_term`]) before building
+/// the sensor's configuration ([`MargConfig::from_tables`]).
+///
+/// With the `serde` feature it deserialises from a table whose keys are the field names, with
+/// the unit suffix dropped where the field has one (`lever_arm`, `correlation_time`,
+/// `reference`); unknown keys are refused.
+///
+/// ```
+/// use margemu_model::sensor::{MargConfig, SensorTable};
+/// let mut gyro = SensorTable::default();
+/// gyro.errors.bias = Some([0.01, 0.0, 0.0]);
+/// gyro.lever_arm_m = Some([0.1, 0.0, 0.0]);
+/// assert_eq!(gyro.foreign_term("gyro"), Some("lever_arm"));
+/// let none = SensorTable::default();
+/// let cfg = MargConfig::from_tables(&gyro, &none, &none);
+/// assert_eq!(cfg.gyro.errors.bias, Some([0.01, 0.0, 0.0]));
+/// assert_eq!(cfg.accel.lever_arm_m, None); // a gyro table's lever arm reaches no sensor
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SensorTable {
+    /// The shared error terms.
+    pub errors: SensorErrors,
+    /// [`GyroConfig::g_sensitivity`] (gyroscope only).
+    pub g_sensitivity: Option<Mat3d>,
+    /// [`AccelConfig::lever_arm_m`] (accelerometer only).
+    pub lever_arm_m: Option<[f64; 3]>,
+    /// [`MagConfig::soft_iron`] (magnetometer only).
+    pub soft_iron: Option<Mat3d>,
+    /// [`MagConfig::hard_iron`] (magnetometer only).
+    pub hard_iron: Option<[f64; 3]>,
+}
+
+impl SensorTable {
+    /// The key of the first term set here that belongs to a sensor other than `sensor`
+    /// (`"gyro"`, `"accel"` or `"mag"`), if any.
+    pub fn foreign_term(&self, sensor: &str) -> Option<&'static str> {
+        let set = [
+            ("g_sensitivity", self.g_sensitivity.is_some(), "gyro"),
+            ("lever_arm", self.lever_arm_m.is_some(), "accel"),
+            ("soft_iron", self.soft_iron.is_some(), "mag"),
+            ("hard_iron", self.hard_iron.is_some(), "mag"),
+        ];
+        set.iter()
+            .find(|(_, present, owner)| *present && *owner != sensor)
+            .map(|(key, _, _)| *key)
+    }
+}
+
+impl MargConfig {
+    /// The configuration of three sensor tables; terms a table holds for another sensor (see
+    /// [`SensorTable::foreign_term`]) are left out.
+    pub fn from_tables(gyro: &SensorTable, accel: &SensorTable, mag: &SensorTable) -> Self {
+        Self {
+            gyro: GyroConfig {
+                errors: gyro.errors,
+                g_sensitivity: gyro.g_sensitivity,
+            },
+            accel: AccelConfig {
+                errors: accel.errors,
+                lever_arm_m: accel.lever_arm_m,
+            },
+            mag: MagConfig {
+                errors: mag.errors,
+                soft_iron: mag.soft_iron,
+                hard_iron: mag.hard_iron,
+            },
+        }
     }
 }

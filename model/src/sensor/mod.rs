@@ -40,10 +40,13 @@
 //! ```
 
 mod config;
+#[cfg(feature = "serde")]
+mod config_serde;
 mod triad;
 
 pub use config::{
-    AccelConfig, BiasInstability, GyroConfig, MagConfig, MargConfig, SensorErrors, TemperatureBias,
+    AccelConfig, BiasInstability, GyroConfig, MagConfig, MargConfig, SensorErrors, SensorTable,
+    TemperatureBias,
 };
 pub use triad::INPUT_LIMIT;
 

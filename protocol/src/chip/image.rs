@@ -42,6 +42,31 @@ impl Image {
         let len = usize::from(self.len).min(MAX_IMAGE_LEN);
         &mut self.bytes[..len]
     }
+
+    /// Parses the image's text form, two hex digits per byte (the [`fmt::LowerHex`] output,
+    /// as `sent.csv` holds it; either case); `None` unless `hex` is exactly `2 · len` hex digits
+    /// and `len` at most [`MAX_IMAGE_LEN`].
+    ///
+    /// ```
+    /// use margemu_protocol::chip::Image;
+    /// let image = Image::new(&[0xab, 0x00, 0x01]).unwrap();
+    /// assert_eq!(format!("{image:x}"), "ab0001");
+    /// assert_eq!(Image::parse_hex("ab0001", 3), Some(image));
+    /// assert_eq!(Image::parse_hex("ab0001", 2), None);
+    /// ```
+    pub fn parse_hex(hex: &str, len: usize) -> Option<Self> {
+        let digits = hex.as_bytes();
+        if digits.len() != 2 * len {
+            return None;
+        }
+        let mut image = Self::zeroed(len)?;
+        let digit = |c: &u8| char::from(*c).to_digit(16);
+        for (slot, pair) in image.as_mut_bytes().iter_mut().zip(digits.chunks_exact(2)) {
+            let [hi, lo] = pair else { return None };
+            *slot = (digit(hi)? << 4 | digit(lo)?) as u8;
+        }
+        Some(image)
+    }
 }
 
 impl Default for Image {
@@ -75,13 +100,19 @@ impl<const N: usize> From<[u8; N]> for Image {
     }
 }
 
+impl fmt::LowerHex for Image {
+    /// The image's text form: two lowercase hex digits per byte, no separator (what `sent.csv`
+    /// holds; [`Image::parse_hex`] reads it back).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.as_bytes()
+            .iter()
+            .try_for_each(|b| write!(f, "{b:02x}"))
+    }
+}
+
 impl fmt::Debug for Image {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "Image(")?;
-        for b in self.as_bytes() {
-            write!(f, "{b:02x}")?;
-        }
-        write!(f, ")")
+        write!(f, "Image({self:x})")
     }
 }
 
@@ -96,5 +127,23 @@ mod tests {
         assert_eq!(Image::from([1u8, 2, 3]), image);
         assert_ne!(Image::new(&[1, 2, 3, 0]).unwrap(), image);
         assert!(Image::new(&[0; MAX_IMAGE_LEN + 1]).is_none());
+    }
+
+    #[test]
+    fn hex_round_trips() {
+        let mut bytes = [0u8; 22];
+        bytes[0] = 0xAB;
+        bytes[21] = 0x01;
+        let image = Image::from(bytes);
+        let mut text = heapless::String::<64>::new();
+        core::fmt::write(&mut text, format_args!("{image:x}")).unwrap();
+        assert_eq!((&text[..4], text.len()), ("ab00", 44));
+        assert_eq!(Image::parse_hex(&text, 22), Some(image));
+        assert_eq!(Image::parse_hex("AB", 1), Image::new(&[0xab]));
+        assert_eq!(Image::parse_hex(&text, 14), None);
+        for bad in ["zz", "+a", "a", "\u{e9}"] {
+            assert_eq!(Image::parse_hex(bad, 1), None, "{bad}");
+        }
+        assert_eq!(Image::parse_hex("", 0), Image::new(&[]));
     }
 }

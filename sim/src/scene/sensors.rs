@@ -1,85 +1,30 @@
 //! `[sensors.<gyro|accel|mag>]` and `[perturbation]`: the MARG error model (paper eq. 18 plus
 //! the terms real parts show) and the magnetic perturbation generator (eq. 19–23).
 //!
-//! Every term is off unless the scene names it; a scene without `[sensors]` produces ideal
-//! samples (the truth rounded to `f32`) at the cost of a copy, and one without
-//! `[perturbation]` runs no generator at all. Units: gyro rad/s, accel m/s², mag the scene's
+//! The sensor terms are the model's own types ([`SensorTable`], one per `[sensors.*]` table,
+//! read by the model's `serde` feature); this module adds the temperature, the plausible ranges
+//! and the TOML key of each model parameter. Every term is off unless the scene names it; a
+//! scene without `[sensors]` produces ideal samples (the truth rounded to `f32`) at the cost of
+//! a copy, and one without `[perturbation]` runs no generator at all. Units: gyro rad/s, accel m/s², mag the scene's
 //! field unit; densities per √Hz, random walks per √s, times in s, temperatures in °C.
 
 use super::error::Violation;
 use margemu_model::perturbation::{Amplitude, PerturbationConfig, Placement};
-use margemu_model::sensor::{
-    AccelConfig, BiasInstability, GyroConfig, MagConfig, MargConfig, SensorErrors, TemperatureBias,
-};
+use margemu_model::sensor::{MargConfig, SensorTable};
 use serde::Deserialize;
-
-/// A 3×3 matrix, row by row.
-pub type Matrix = [[f64; 3]; 3];
 
 /// `[sensors]`: one table per sensor, and the temperature the sensors see.
 #[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorsSpec {
     /// Gyroscope (rad/s).
-    pub gyro: SensorSpec,
+    pub gyro: SensorTable,
     /// Accelerometer (m/s²).
-    pub accel: SensorSpec,
+    pub accel: SensorTable,
     /// Magnetometer (scene field unit).
-    pub mag: SensorSpec,
+    pub mag: SensorTable,
     /// `[start °C, slope °C/s]`: the temperature for temperature-dependent biases.
     pub temperature: Option<[f64; 2]>,
-}
-
-/// One sensor's error terms; each is off when absent.
-#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct SensorSpec {
-    /// ΔS of eq. 18: scale-factor error matrix (0 = none).
-    pub scale_factor: Option<Matrix>,
-    /// M of eq. 18: misalignment matrix (identity = aligned).
-    pub misalignment: Option<Matrix>,
-    /// Constant bias.
-    pub bias: Option<[f64; 3]>,
-    /// White noise density (unit/√Hz): σ = density · √rate.
-    pub noise_density: Option<[f64; 3]>,
-    /// Bias instability: a first-order Gauss–Markov process.
-    pub bias_instability: Option<BiasInstabilitySpec>,
-    /// Rate random walk (unit/√s).
-    pub rate_random_walk: Option<[f64; 3]>,
-    /// Temperature-dependent bias: `coefficient · (T − reference)`.
-    pub temperature_bias: Option<TemperatureBiasSpec>,
-    /// Output resolution (quantization step).
-    pub resolution: Option<[f64; 3]>,
-    /// Output range: values clip at ±range.
-    pub range: Option<[f64; 3]>,
-    /// Gyro only: g-sensitivity matrix ((rad/s)/(m/s²)) applied to the specific force.
-    pub g_sensitivity: Option<Matrix>,
-    /// Accelerometer only: sensor position relative to the rotation centre (m, body axes).
-    pub lever_arm: Option<[f64; 3]>,
-    /// Magnetometer only: soft-iron matrix B_si of eq. 18.
-    pub soft_iron: Option<Matrix>,
-    /// Magnetometer only: hard-iron vector b_hi of eq. 18.
-    pub hard_iron: Option<[f64; 3]>,
-}
-
-/// Bias instability parameters.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct BiasInstabilitySpec {
-    /// The Allan-deviation floor B (unit).
-    pub coefficient: [f64; 3],
-    /// Correlation time (s).
-    pub correlation_time: f64,
-}
-
-/// Temperature-dependent bias parameters.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct TemperatureBiasSpec {
-    /// Bias per °C.
-    pub coefficient: [f64; 3],
-    /// Temperature of zero bias (°C).
-    pub reference: f64,
 }
 
 /// How burst amplitudes are drawn.
@@ -140,59 +85,11 @@ impl Default for PerturbationSpec {
     }
 }
 
-impl SensorSpec {
-    fn errors(&self) -> SensorErrors {
-        SensorErrors {
-            scale_factor: self.scale_factor,
-            misalignment: self.misalignment,
-            bias: self.bias,
-            noise_density: self.noise_density,
-            bias_instability: self.bias_instability.map(|b| BiasInstability {
-                coefficient: b.coefficient,
-                correlation_time_s: b.correlation_time,
-            }),
-            rate_random_walk: self.rate_random_walk,
-            temperature_bias: self.temperature_bias.map(|t| TemperatureBias {
-                coefficient: t.coefficient,
-                reference_c: t.reference,
-            }),
-            resolution: self.resolution,
-            range: self.range,
-        }
-    }
-
-    /// The keys set that belong to another sensor, for `sensor` (`gyro`, `accel`, `mag`).
-    pub(crate) fn foreign_keys(&self, sensor: &str) -> Option<&'static str> {
-        let set = [
-            ("g_sensitivity", self.g_sensitivity.is_some(), "gyro"),
-            ("lever_arm", self.lever_arm.is_some(), "accel"),
-            ("soft_iron", self.soft_iron.is_some(), "mag"),
-            ("hard_iron", self.hard_iron.is_some(), "mag"),
-        ];
-        set.iter()
-            .find(|(_, present, owner)| *present && *owner != sensor)
-            .map(|(k, _, _)| *k)
-    }
-}
-
 impl SensorsSpec {
-    /// The model configuration.
+    /// The model configuration (terms in the table of another sensor, which validation
+    /// refuses, are left out).
     pub fn config(&self) -> MargConfig {
-        MargConfig {
-            gyro: GyroConfig {
-                errors: self.gyro.errors(),
-                g_sensitivity: self.gyro.g_sensitivity,
-            },
-            accel: AccelConfig {
-                errors: self.accel.errors(),
-                lever_arm_m: self.accel.lever_arm,
-            },
-            mag: MagConfig {
-                errors: self.mag.errors(),
-                soft_iron: self.mag.soft_iron,
-                hard_iron: self.mag.hard_iron,
-            },
-        }
+        MargConfig::from_tables(&self.gyro, &self.accel, &self.mag)
     }
 }
 
@@ -238,8 +135,8 @@ pub(crate) fn check_ranges(spec: &super::SceneSpec) -> Result<(), Violation> {
     for (name, sensor) in [("gyro", &s.gyro), ("accel", &s.accel), ("mag", &s.mag)] {
         let term = ranges::SENSOR_TERM;
         let matrices = [
-            ("scale_factor", &sensor.scale_factor),
-            ("misalignment", &sensor.misalignment),
+            ("scale_factor", &sensor.errors.scale_factor),
+            ("misalignment", &sensor.errors.misalignment),
             ("g_sensitivity", &sensor.g_sensitivity),
             ("soft_iron", &sensor.soft_iron),
         ];
@@ -249,12 +146,12 @@ pub(crate) fn check_ranges(spec: &super::SceneSpec) -> Result<(), Violation> {
             }
         }
         let vectors = [
-            ("bias", &sensor.bias),
-            ("noise_density", &sensor.noise_density),
-            ("rate_random_walk", &sensor.rate_random_walk),
-            ("resolution", &sensor.resolution),
-            ("range", &sensor.range),
-            ("lever_arm", &sensor.lever_arm),
+            ("bias", &sensor.errors.bias),
+            ("noise_density", &sensor.errors.noise_density),
+            ("rate_random_walk", &sensor.errors.rate_random_walk),
+            ("resolution", &sensor.errors.resolution),
+            ("range", &sensor.errors.range),
+            ("lever_arm", &sensor.lever_arm_m),
             ("hard_iron", &sensor.hard_iron),
         ];
         for (key, v) in vectors {
@@ -262,10 +159,10 @@ pub(crate) fn check_ranges(spec: &super::SceneSpec) -> Result<(), Violation> {
                 check(v, &["sensors", name, key], term)?;
             }
         }
-        if let Some(b) = &sensor.bias_instability {
+        if let Some(b) = &sensor.errors.bias_instability {
             let at = ["sensors", name, "bias_instability"];
             check(&b.coefficient, &[at[0], at[1], at[2], "coefficient"], term)?;
-            let time = [b.correlation_time];
+            let time = [b.correlation_time_s];
             check(
                 &time,
                 &[at[0], at[1], at[2], "correlation_time"],
@@ -276,11 +173,11 @@ pub(crate) fn check_ranges(spec: &super::SceneSpec) -> Result<(), Violation> {
                 v
             })?;
         }
-        if let Some(t) = &sensor.temperature_bias {
+        if let Some(t) = &sensor.errors.temperature_bias {
             let at = ["sensors", name, "temperature_bias"];
             check(&t.coefficient, &[at[0], at[1], at[2], "coefficient"], term)?;
             check(
-                &[t.reference],
+                &[t.reference_c],
                 &[at[0], at[1], at[2], "reference"],
                 ranges::TEMPERATURE,
             )

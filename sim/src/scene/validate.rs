@@ -71,7 +71,7 @@ fn check_sensors(spec: &SceneSpec) -> Check {
         ("accel", &sensors.accel),
         ("mag", &sensors.mag),
     ] {
-        if let Some(key) = sensor.foreign_keys(name) {
+        if let Some(key) = sensor.foreign_term(name) {
             return Err(Violation::at(
                 &["sensors", name, key],
                 format!("does not apply to `{name}`"),

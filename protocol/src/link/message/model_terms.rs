@@ -20,7 +20,9 @@
 //! | 10 | mag `hard_iron` (24); reserved (0) for gyro and accel | |
 //!
 //! Bits 11..15 are reserved and must be 0. Values are carried bit for bit; the model validates
-//! them when the device builds it.
+//! them when the device builds it. The types are the model's own (its one definition of the
+//! sensor configuration, which the host's scenes also read into); this module only fixes their
+//! byte order, and names their fields nowhere else.
 
 use margemu_model::perturbation::{Amplitude, PerturbationConfig, Placement};
 use margemu_model::sensor::{

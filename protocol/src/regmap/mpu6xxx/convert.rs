@@ -108,9 +108,17 @@ pub fn mag_to_raw(b: f32, asa: u8, bits: MagBits) -> i16 {
 
 /// The field in the AK8963's own axes from the field in the MPU-9250 accel/gyro axes: the
 /// magnetometer die is mounted with x and y swapped and z reversed (PS section 9.1, figure
-/// "Orientation of Axes of Sensitivity"): `x_ak = y_mpu`, `y_ak = x_mpu`, `z_ak = −z_mpu`.
-pub fn mag_axes_from_mpu(b: [f32; 3]) -> [f32; 3] {
-    [b[1], b[0], -b[2]]
+/// "Orientation of Axes of Sensitivity"): `x_ak = y_mpu`, `y_ak = x_mpu`, `z_ak = −z_mpu`. The
+/// one statement of that mounting: [`mag_axes_to_mpu`] is its inverse.
+pub fn mag_axes_from_mpu<T: Copy + core::ops::Neg<Output = T>>(b: [T; 3]) -> [T; 3] {
+    let [x, y, z] = b;
+    [y, x, -z]
+}
+
+/// The field in the MPU-9250 accel/gyro axes from the field in the AK8963's own axes: the
+/// inverse of [`mag_axes_from_mpu`] (the swap and the sign flip undo themselves).
+pub fn mag_axes_to_mpu<T: Copy + core::ops::Neg<Output = T>>(b: [T; 3]) -> [T; 3] {
+    mag_axes_from_mpu(b)
 }
 
 /// A measurement as the AK8963 stores it: the three data register values (AK8963 axes) and
@@ -264,6 +272,10 @@ mod tests {
     #[test]
     fn magnetometer_axes_and_overflow() {
         assert_eq!(mag_axes_from_mpu([1.0, 2.0, 3.0]), [2.0, 1.0, -3.0]);
+        assert_eq!(
+            mag_axes_to_mpu(mag_axes_from_mpu([1.0, 2.0, 3.0])),
+            [1.0, 2.0, 3.0]
+        );
         let (raw, hofl) = mag_measurement([15.0, 30.0, -45.0], [128; 3], MagBits::Bits16);
         assert_eq!(raw, [200, 100, 300]);
         assert!(!hofl);

@@ -31,8 +31,8 @@
 use core::ops::Range;
 
 use super::convert::{
-    accel_to_raw_with_offset, asa_factor, gyro_to_raw_with_offset, mag_measurement,
-    STANDARD_GRAVITY,
+    accel_to_raw_with_offset, asa_factor, gyro_to_raw_with_offset, mag_axes_to_mpu,
+    mag_measurement, STANDARD_GRAVITY,
 };
 use super::variant::TempScale;
 use super::{AccelFs, GyroFs};
@@ -248,7 +248,7 @@ impl ImageRepr {
                 (f64::from(self.gyro[i]) - gyro_offset_lsb(i)) / lsb_per_radps
             }),
             temp_c: cfg.temp.from_raw(self.temp),
-            mag_ut: [ut(1), ut(0), -ut(2)],
+            mag_ut: mag_axes_to_mpu([ut(0), ut(1), ut(2)]),
         }
     }
 
