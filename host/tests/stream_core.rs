@@ -10,7 +10,7 @@ mod common;
 use common::{assert_logs_valid, config, read_csv, scene, scratch, served};
 use margemu::stream::clock::{Clock, VirtualClock};
 use margemu::stream::virtual_port::Trace;
-use margemu::stream::{Session, StreamConfig, StreamError, Summary, VirtualPort};
+use margemu::stream::{Session, SourceMode, StreamConfig, StreamError, Summary, VirtualPort};
 use margemu_protocol::link::{DeviceState, Rate};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -367,6 +367,49 @@ fn the_scene_ends_with_stop_after_the_last_item_and_exact_counts() {
         .starts_with("served 1000 samples; last index 999; underruns 0"));
     assert_eq!(events(&out.dir, "end")[0].1, "completed");
     assert_logs_valid(&out.dir);
+}
+
+#[test]
+fn in_source_model_stop_waits_for_the_device_to_report_the_last_sample() {
+    let clock = VirtualClock::new();
+    let config = StreamConfig {
+        source: SourceMode::Model {
+            kinematics_hz: None,
+        },
+        ..virtual_config()
+    };
+    // Polled every 2 ms, the device serves the last instant (999 ms after Start, which went out
+    // at a tick) at the next tick, after Stop's half period.
+    let device = VirtualPort::new(clock.clone(), 2 * MS);
+    let out = run("model", clock.clone(), device, config);
+    let s = out.summary();
+    // 500 kinematics samples (hold 2) in batches of 28, the lead capped at 96 of them (192 ms).
+    assert_eq!((s.stream_len, s.sent, s.batch), (500, 500, 28));
+    assert_eq!(s.lead, Duration::from_millis(192));
+    assert_eq!(s.link.batch_frames, 500u64.div_ceil(28));
+    let v = s.served;
+    assert_eq!(
+        (v.byte_exact, v.underruns, v.mismatched, v.unreported),
+        (SAMPLES, 0, 0, 0),
+        "{v:?}"
+    );
+    // The device stops at once on Stop, so Stop waits for the half period after the last
+    // instant and then for the device's first report of the last sample served.
+    let stop_at = out.start() + 999 * MS + MS / 2;
+    let (_, served_rows) = read_csv(&out.dir, "served.csv");
+    let in_served = served_rows.iter().filter(|r| r[1] == "999");
+    let (_, device_rows) = read_csv(&out.dir, "device.csv");
+    let in_telemetry = device_rows
+        .iter()
+        .filter(|r| r[2] != "0" && r[3].parse::<u64>().unwrap() >= 999);
+    let reported = in_served
+        .chain(in_telemetry)
+        .map(|r| r[0].parse::<u64>().unwrap())
+        .min()
+        .unwrap();
+    assert!(reported > stop_at, "reported at {reported}");
+    assert_eq!(out.trace.stop_ns, Some(reported));
+    assert_eq!(out.trace.state, Some(DeviceState::Stopped));
 }
 
 #[test]
