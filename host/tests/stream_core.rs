@@ -413,6 +413,39 @@ fn in_source_model_stop_waits_for_the_device_to_report_the_last_sample() {
 }
 
 #[test]
+fn the_stop_flag_sends_stop_at_once_and_the_device_confirms_it() {
+    let clock = VirtualClock::new();
+    let device = device(&clock);
+    let trace = device.trace();
+    let dir = scratch("core-interrupted");
+    let session = Session::new(&scene(1.0, 1000.0), virtual_config(), &dir).unwrap();
+    let stop = session.stop_flag();
+    let mut set_at = None;
+    let result = session.run_with(device, |p| {
+        if p.elapsed >= Duration::from_millis(300) && set_at.is_none() {
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            set_at = Some(clock.now_ns());
+        }
+    });
+    assert!(
+        matches!(result, Err(StreamError::Interrupted)),
+        "{result:?}"
+    );
+    let trace = take(&trace);
+    // The flag is seen before the next wait, at the same instant.
+    let set_at = set_at.unwrap();
+    assert_eq!(trace.stop_ns, Some(set_at));
+    assert!(trace.batches.iter().all(|b| b.at_ns <= set_at));
+    assert_eq!(trace.state, Some(DeviceState::Stopped));
+    assert_eq!(events(&dir, "stopped").len(), 1);
+    let end = events(&dir, "end");
+    assert!(end[0].1.starts_with("error: interrupted"), "{end:?}");
+    let meta = std::fs::read_to_string(dir.join("meta.toml")).unwrap();
+    assert!(meta.contains("status = \"interrupted\""), "{meta}");
+    assert_logs_valid(&dir);
+}
+
+#[test]
 fn the_same_session_on_the_virtual_clock_logs_the_same_bytes() {
     let runs: Vec<_> = ["again-1", "again-2"]
         .iter()
