@@ -10,15 +10,16 @@ use margemu_protocol::link::{DeviceState, Message};
 
 impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
     /// Whether the device's last Telemetry says it has stopped.
-    fn device_stopped(&self) -> bool {
-        self.telemetry
+    pub(super) fn device_stopped(&self) -> bool {
+        self.reports
+            .telemetry
             .is_some_and(|t| t.state == DeviceState::Stopped)
     }
 
     /// Logs whether the device confirmed Stop: `stopped` (with what it served) or
     /// `stop_unconfirmed`.
     pub(super) fn log_stop_outcome(&mut self) -> Result<(), StreamError> {
-        match self.telemetry {
+        match self.reports.telemetry {
             Some(t) if t.state == DeviceState::Stopped => {
                 let detail = format!(
                     "served {} samples, last index {}, underruns {}",

@@ -34,24 +34,14 @@ pub(super) struct Run<'s, L: Port, P: FnMut(&Progress)> {
     pub(super) wire: Vec<u8>,
     /// When Start was written, host ns: scene time 0.
     pub(super) start: Option<u64>,
-    /// The device's newest credit window.
-    pub(super) credit: Credit,
-    pub(super) credit_seen: bool,
-    pub(super) ack: Option<HelloAck>,
-    pub(super) telemetry: Option<Telemetry>,
-    pub(super) host_rx: RxStats,
+    /// What the device has said so far.
+    pub(super) reports: Reports,
     /// The Served reports against the prediction (its window set by the plan).
     pub(super) served: ServedCheck,
-    /// How late the paced batches' writes started.
-    pub(super) late: Lateness,
-    /// How late the same writes completed.
-    pub(super) written_late: Lateness,
-    pub(super) max_late_ns: i64,
-    pub(super) credit_stalls: u64,
+    /// What the run measured of its own writes.
+    pub(super) figures: Figures,
     /// The next item to write.
     pub(super) next: u64,
-    /// Bytes written to the port: all, and those of sample batches with their item bytes.
-    pub(super) link: LinkStats,
     /// When each recent item was last written (its window set by the plan); the go-backs.
     pub(super) go_back: GoBackN,
     /// Stop was written: reports no longer lead to resends.
@@ -59,6 +49,33 @@ pub(super) struct Run<'s, L: Port, P: FnMut(&Progress)> {
     pub(super) progress: P,
     /// When the progress callback was last called, host ns.
     pub(super) last_progress: u64,
+}
+
+/// What the device has said so far: its HelloAck, its newest credit window and Telemetry, and
+/// what the host's receiver counted.
+#[derive(Default)]
+pub(super) struct Reports {
+    pub(super) ack: Option<HelloAck>,
+    /// The device's newest credit window.
+    pub(super) credit: Credit,
+    /// A credit window arrived since Configure was written.
+    pub(super) credit_seen: bool,
+    pub(super) telemetry: Option<Telemetry>,
+    pub(super) host_rx: RxStats,
+}
+
+/// What a run measured of its own writes: pacing lateness, credit stalls, bytes.
+#[derive(Default)]
+pub(super) struct Figures {
+    /// How late the paced batches' writes started.
+    pub(super) late: Lateness,
+    /// How late the same writes completed.
+    pub(super) written_late: Lateness,
+    pub(super) max_late_ns: i64,
+    /// Times a due batch had to wait for credit.
+    pub(super) credit_stalls: u64,
+    /// Bytes written to the port: all, and those of sample batches with their item bytes.
+    pub(super) link: LinkStats,
 }
 
 impl<'s, L: Port, P: FnMut(&Progress)> Run<'s, L, P> {
@@ -73,18 +90,10 @@ impl<'s, L: Port, P: FnMut(&Progress)> Run<'s, L, P> {
             encoder: Encoder::new(),
             wire: vec![0; margemu_protocol::link::MAX_WIRE_LEN],
             start: None,
-            credit: Credit::default(),
-            credit_seen: false,
-            ack: None,
-            telemetry: None,
-            host_rx: RxStats::default(),
+            reports: Reports::default(),
             served: ServedCheck::new(samples, 1),
-            late: Lateness::new(),
-            written_late: Lateness::new(),
-            max_late_ns: 0,
-            credit_stalls: 0,
+            figures: Figures::default(),
             next: 0,
-            link: LinkStats::default(),
             go_back: GoBackN::new(1),
             stop_sent: false,
             progress,
@@ -147,7 +156,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
 
     /// Writes the first `len` bytes of the wire buffer (one encoded frame).
     pub(super) fn write_wire(&mut self, len: usize) -> Result<(), StreamError> {
-        self.link.wire_bytes += len as u64;
+        self.figures.link.wire_bytes += len as u64;
         self.port
             .write(&self.wire[..len])
             .map_err(|e| StreamError::Disconnected {
@@ -180,19 +189,19 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
     pub(super) fn handle(&mut self, event: RxEvent) -> Result<(), StreamError> {
         match event {
             RxEvent::Stats(s) => {
-                if s.crc_errors != self.host_rx.crc_errors
-                    || s.framing_errors != self.host_rx.framing_errors
-                    || s.lost_frames != self.host_rx.lost_frames
-                    || s.rejected_messages != self.host_rx.rejected_messages
+                if s.crc_errors != self.reports.host_rx.crc_errors
+                    || s.framing_errors != self.reports.host_rx.framing_errors
+                    || s.lost_frames != self.reports.host_rx.lost_frames
+                    || s.rejected_messages != self.reports.host_rx.rejected_messages
                 {
                     let detail = format!(
                         "crc {} framing {} lost {} rejected {}",
                         s.crc_errors, s.framing_errors, s.lost_frames, s.rejected_messages
                     );
-                    self.host_rx = s;
+                    self.reports.host_rx = s;
                     self.event("host_rx_errors", &detail)?;
                 }
-                self.host_rx = s;
+                self.reports.host_rx = s;
                 Ok(())
             }
             RxEvent::Closed(e) => Err(StreamError::Disconnected {
@@ -216,7 +225,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
         };
         self.send(&Message::Hello(hello))?;
         let deadline = self.now() + self.plan.hello_timeout_ns;
-        while self.ack.is_none() {
+        while self.reports.ack.is_none() {
             if self.now() >= deadline {
                 return Err(StreamError::HelloTimeout {
                     timeout: self.session.config.hello_timeout,
@@ -224,7 +233,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
             }
             self.pump(deadline)?;
         }
-        let ack = self.ack.expect("checked above");
+        let ack = self.reports.ack.expect("checked above");
         if ack.protocol_version != PROTOCOL_VERSION {
             return Err(StreamError::VersionMismatch {
                 device: ack.protocol_version,
@@ -257,10 +266,10 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
     fn configure(&mut self) -> Result<(), StreamError> {
         let period = self.session.config.telemetry_period.as_nanos() as u64;
         let cfg = self.session.configure_message(period);
-        self.credit_seen = false;
+        self.reports.credit_seen = false;
         self.send(&Message::Configure(cfg))?;
         let deadline = self.now() + self.plan.hello_timeout_ns;
-        while !self.credit_seen {
+        while !self.reports.credit_seen {
             if self.now() >= deadline {
                 return Err(StreamError::CreditTimeout {
                     index: 0,
@@ -272,7 +281,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
         self.plan_pacing();
         let detail = format!(
             "credit limit {}; batch {}; lead {} us",
-            self.credit.limit,
+            self.reports.credit.limit,
             self.plan.batch,
             self.plan.lead_ns / 1000
         );
@@ -295,10 +304,10 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
             total: self.plan.stream_len,
             resends: self.go_back.rewinds(),
             elapsed: self.elapsed(),
-            telemetry: self.telemetry,
-            host_rx: self.host_rx,
-            last_late_ns: self.late.last_ns(),
-            max_late_ns: self.max_late_ns,
+            telemetry: self.reports.telemetry,
+            host_rx: self.reports.host_rx,
+            last_late_ns: self.figures.late.last_ns(),
+            max_late_ns: self.figures.max_late_ns,
             served: self.served.stats(),
         }
     }
@@ -311,18 +320,18 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
             resent: self.go_back.resent(),
             dir: self.session.log.dir().to_path_buf(),
             start_host_ns: self.start.map(Self::host_ns),
-            jitter: self.late.stats(),
-            written_jitter: self.written_late.stats(),
-            telemetry: self.telemetry,
-            device: self.ack,
-            host_rx: self.host_rx,
-            credit_stalls: self.credit_stalls,
+            jitter: self.figures.late.stats(),
+            written_jitter: self.figures.written_late.stats(),
+            telemetry: self.reports.telemetry,
+            device: self.reports.ack,
+            host_rx: self.reports.host_rx,
+            credit_stalls: self.figures.credit_stalls,
             served: self.served.stats(),
             stream_len: self.plan.stream_len,
             source: self.session.source(),
             batch: self.plan.batch,
             lead: Duration::from_nanos(self.plan.lead_ns),
-            link: self.link,
+            link: self.figures.link,
             image_settings: self.session.settings,
             elapsed: self.elapsed(),
         }

@@ -15,7 +15,7 @@ use super::served::{served_window, ServedCheck, MAX_WINDOW};
 use super::window::Window;
 use super::Progress;
 use super::StreamError;
-use margemu_protocol::link::{DeviceState, Message, Start};
+use margemu_protocol::link::{Message, Start};
 
 /// Batches predicted beyond the next one to write.
 const PREDICT_AHEAD: u64 = 2;
@@ -29,7 +29,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
     /// finds them); the Served check's ([`served_window`], those predicted ahead counted as
     /// buffered).
     pub(super) fn plan_pacing(&mut self) {
-        self.plan = Plan::new(self.session, self.ack.as_ref());
+        self.plan = Plan::new(self.session, self.reports.ack.as_ref());
         let (batch, capacity) = (self.plan.batch as usize, self.plan.capacity as usize);
         let ahead = PREDICT_AHEAD as usize * batch;
         let buffered = u32::try_from(capacity.saturating_add(ahead)).unwrap_or(u32::MAX);
@@ -58,9 +58,9 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
             .session
             .emit_batch(first, n, &mut self.encoder, &mut self.wire);
         self.write_wire(len)?;
-        self.link.batch_frames += 1;
-        self.link.batch_wire_bytes += len as u64;
-        self.link.item_bytes += n * self.session.item_len();
+        self.figures.link.batch_frames += 1;
+        self.figures.link.batch_wire_bytes += len as u64;
+        self.figures.link.item_bytes += n * self.session.item_len();
         let sent_at = self.now();
         let send_ns = Self::host_ns(sent_at);
         let late = |due: u64, at: u64| at.saturating_sub(due) as i64;
@@ -68,9 +68,9 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
         self.go_back.written(first, n, send_ns);
         if let (Some(due), true) = (due, paced && !resend) {
             let late = |at: u64| late(due, at);
-            self.late.record(late(started));
-            self.written_late.record(late(sent_at));
-            self.max_late_ns = self.max_late_ns.max(late(started));
+            self.figures.late.record(late(started));
+            self.figures.written_late.record(late(sent_at));
+            self.figures.max_late_ns = self.figures.max_late_ns.max(late(started));
         }
         self.next += n;
         let late_ns = late_ns.filter(|_| !resend);
@@ -86,12 +86,12 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
         // Prefill: every item due at Start, within the first window.
         while self.next < total
             && rate.sample_time_ns(self.next) <= lead_ns
-            && self.credit.available(self.next) > 0
+            && self.reports.credit.available(self.next) > 0
         {
             let n = self
                 .plan
                 .batch
-                .min(self.credit.available(self.next))
+                .min(self.reports.credit.available(self.next))
                 .min(total - self.next);
             self.write_batch(n, None, false)?;
         }
@@ -127,14 +127,14 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
         self.port.spin_until(due);
         // The batch goes out first; device messages wait, unless the window is short.
         let wanted = self.plan.batch.min(total - self.next);
-        if self.credit.available(self.next) < wanted {
+        if self.reports.credit.available(self.next) < wanted {
             self.handle_waiting()?;
         }
-        let available = self.credit.available(self.next);
+        let available = self.reports.credit.available(self.next);
         if available == 0 {
             let now = self.now();
             let since = *stall.get_or_insert_with(|| {
-                self.credit_stalls += 1;
+                self.figures.credit_stalls += 1;
                 now
             });
             let timeout = self.plan.credit_timeout;
@@ -163,6 +163,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
         let served = |run: &Self| {
             run.served.stats().last_index >= Some(last)
                 || run
+                    .reports
                     .telemetry
                     .is_some_and(|t| t.samples_served > 0 && t.last_served_index >= last)
         };
@@ -203,11 +204,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
         self.stop_sent = true;
         self.send(&Message::Stop)?;
         let deadline = self.now() + drain;
-        while self.now() < deadline
-            && !self
-                .telemetry
-                .is_some_and(|t| t.state == DeviceState::Stopped)
-        {
+        while self.now() < deadline && !self.device_stopped() {
             self.pump(deadline)?;
         }
         self.report(true);

@@ -56,16 +56,16 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
             DeviceMessage::Credit(c) => self.window(c),
             DeviceMessage::Telemetry(t) => {
                 self.window(t.credit());
-                self.telemetry = Some(t);
+                self.reports.telemetry = Some(t);
                 self.check_lost(&t)?;
             }
             DeviceMessage::HelloAck(a) if a.session == self.session.config.session_id => {
-                self.ack = Some(a);
+                self.reports.ack = Some(a);
             }
             DeviceMessage::HelloAck(_)
             | DeviceMessage::RegisterWrites { .. }
             | DeviceMessage::Served { .. } => {}
-            DeviceMessage::Reset(r) if self.ack.is_some() => {
+            DeviceMessage::Reset(r) if self.reports.ack.is_some() => {
                 return Err(StreamError::DeviceReset {
                     cause: format!("{:?}", r.cause),
                 })
@@ -147,8 +147,8 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
     }
 
     fn window(&mut self, c: Credit) {
-        self.credit = c;
-        self.credit_seen = true;
+        self.reports.credit = c;
+        self.reports.credit_seen = true;
     }
 }
 
