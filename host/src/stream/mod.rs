@@ -34,7 +34,7 @@
 //! [`Port`], which writes its frames, hands over the device's and owns a [`clock::Clock`]. What
 //! is fixed for a session once the device has answered (counts, rates, batch, lead, timeouts)
 //! is one plan set once; the run owns its mutable state. [`Session::run`] uses a
-//! [`SerialPort`]: the real port, a receive thread ([`rx`]) that decodes the device's frames
+//! [`SystemPort`]: the real port, a receive thread ([`rx`]) that decodes the device's frames
 //! concurrently and counts damaged ones, and the host's monotonic clock
 //! ([`clock::SystemClock`]). [`Session::run_with`] takes any port: a [`VirtualPort`] runs the
 //! firmware's link handler on a [`clock::VirtualClock`], with injected faults (a lost batch,
@@ -92,7 +92,7 @@ pub use lateness::Lateness;
 pub use model::{
     device_chip, kinematics_hold, model_images, predict_model, ModelPrediction, ModelSample,
 };
-pub use port::{Port, SerialPort};
+pub use port::{Port, SystemPort};
 pub use predictor::Predictions;
 pub use served::{served_window, ServedCheck, ServedStats};
 pub use session::{rate_of, Session, SourceMode, StreamConfig};

@@ -4,7 +4,7 @@
 //! (the last stretch before a send instant), so where its time comes from is the port's
 //! business:
 //!
-//! - [`SerialPort`]: a real port (a serial device or a pseudo-terminal), its receive thread
+//! - [`SystemPort`]: a real port (a serial device or a pseudo-terminal), its receive thread
 //!   ([`super::rx`]) and the [`SystemClock`];
 //! - [`VirtualPort`](super::virtual_port::VirtualPort): the firmware's link handler driven on a
 //!   [`VirtualClock`](super::clock::VirtualClock), for exact tests that do not depend on the
@@ -36,14 +36,14 @@ pub trait Port {
 
 /// A real port: `writer` takes the frames, a receive thread decodes what the device sends, the
 /// time is the [`SystemClock`]'s. Dropping it ends the receive thread (at its next read).
-pub struct SerialPort<W: Write> {
+pub struct SystemPort<W: Write> {
     clock: SystemClock,
     writer: W,
     events: Receiver<RxEvent>,
     shutdown: Arc<AtomicBool>,
 }
 
-impl<W: Write> SerialPort<W> {
+impl<W: Write> SystemPort<W> {
     /// Starts the receive thread on `reader` (which must return from `read` now and then, by
     /// data, timeout or end of file); events are stamped with `clock`.
     pub fn new(reader: impl Read + Send + 'static, writer: W, clock: SystemClock) -> Self {
@@ -58,13 +58,13 @@ impl<W: Write> SerialPort<W> {
     }
 }
 
-impl<W: Write> Drop for SerialPort<W> {
+impl<W: Write> Drop for SystemPort<W> {
     fn drop(&mut self) {
         self.shutdown.store(true, Ordering::Relaxed);
     }
 }
 
-impl<W: Write> Port for SerialPort<W> {
+impl<W: Write> Port for SystemPort<W> {
     fn now_ns(&self) -> u64 {
         self.clock.now_ns()
     }

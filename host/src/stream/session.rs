@@ -8,7 +8,7 @@ use super::log::{SessionLog, SENT_COLUMNS, SENT_KINEMATICS_COLUMNS};
 use super::logger::Logger;
 use super::meta::metadata;
 use super::model::predict_model;
-use super::port::{Port, SerialPort};
+use super::port::{Port, SystemPort};
 use super::source::{Items, Prediction};
 use super::{Progress, StreamError, Summary};
 use crate::rundir::{Completion, CompletionRecord, Status};
@@ -220,7 +220,7 @@ impl Session {
         let clock = self
             .origin
             .map_or_else(SystemClock::new, SystemClock::with_origin);
-        self.run_with(SerialPort::new(reader, writer, clock), progress)
+        self.run_with(SystemPort::new(reader, writer, clock), progress)
     }
 
     /// [`Session::run`] on any [`Port`]: every host time the session waits for or logs comes
