@@ -109,3 +109,50 @@ impl Plan {
         Some(start + t_last + (t_next - t_last) / 2)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(samples: u64, rate: Rate) -> Plan {
+        Plan {
+            samples,
+            stream_len: samples,
+            rate,
+            item_rate: rate,
+            hold: 1,
+            stops_at_once: false,
+            batch: 32,
+            lead_ns: 96_000_000,
+            capacity: 256,
+            spin_ns: 0,
+            hello_timeout_ns: 0,
+            credit_timeout: Duration::ZERO,
+            drain_ns: 0,
+            resend_after_ns: 0,
+        }
+    }
+
+    #[test]
+    fn batches_are_due_a_lead_ahead_and_never_before_start() {
+        let p = plan(1000, Rate::new(1000, 1).unwrap());
+        assert_eq!(p.due(5, 0), 5);
+        assert_eq!(p.due(5, 96), 5);
+        assert_eq!(p.due(5, 97), 5 + 1_000_000);
+        assert_eq!(p.due(5, 200), 5 + 104_000_000);
+    }
+
+    #[test]
+    fn stop_is_due_half_a_period_after_the_last_instant() {
+        assert_eq!(
+            plan(1000, Rate::new(1000, 1).unwrap()).stop_at(5),
+            Some(5 + 999_500_000)
+        );
+        // 3 Hz: instants 0, 333 333 333, 666 666 666 ns, then 1 s.
+        assert_eq!(
+            plan(3, Rate::new(3, 1).unwrap()).stop_at(0),
+            Some(833_333_333)
+        );
+        assert_eq!(plan(0, Rate::new(3, 1).unwrap()).stop_at(0), None);
+    }
+}
