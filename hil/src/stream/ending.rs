@@ -4,23 +4,22 @@
 //! `events.csv` says whether the device confirmed it (`stopped`) or not (`stop_unconfirmed`).
 
 use super::flow::Run;
-use super::rx;
+use super::port::Port;
 use super::{Progress, StreamError};
 use margemu_protocol::link::{DeviceState, Message};
-use std::io::Write;
-use std::time::{Duration, Instant};
 
-impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
+impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
     /// Whether the device's last Telemetry says it has stopped.
-    fn device_stopped(&self) -> bool {
-        self.telemetry
+    pub(super) fn device_stopped(&self) -> bool {
+        self.reports
+            .telemetry
             .is_some_and(|t| t.state == DeviceState::Stopped)
     }
 
     /// Logs whether the device confirmed Stop: `stopped` (with what it served) or
     /// `stop_unconfirmed`.
     pub(super) fn log_stop_outcome(&mut self) -> Result<(), StreamError> {
-        match self.telemetry {
+        match self.reports.telemetry {
             Some(t) if t.state == DeviceState::Stopped => {
                 let detail = format!(
                     "served {} samples, last index {}, underruns {}",
@@ -42,10 +41,9 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             let _ = self.event("stop_unconfirmed", "Stop could not be written");
             return;
         }
-        let deadline = Instant::now() + self.session.config.drain_timeout;
-        while !self.device_stopped() && Instant::now() < deadline {
-            let wait = deadline.min(Instant::now() + Duration::from_millis(50));
-            if let Some(event) = rx::recv_until(&self.events, wait) {
+        let deadline = self.now() + self.plan.drain_ns;
+        while !self.device_stopped() && self.now() < deadline {
+            if let Some(event) = self.port.wait(deadline) {
                 if self.handle(event).is_err() {
                     break;
                 }

@@ -1,4 +1,4 @@
-//! Real-time streaming of a scene to a device over a serial port (issue 5), in either source
+//! Real-time streaming of a scene to a device over a serial port, in either source
 //! mode of `docs/spec/link.md`: (a) register images, (b) true kinematics for the device's own
 //! sensor model.
 //!
@@ -21,7 +21,7 @@
 //!    the first Credit;
 //! 3. prefill (the items due within the lead, as far as the window allows), then Start
 //!    (`t0_ns` = 0, `end_index` = the scene's sample count), which sets scene time 0 on the
-//!    host's monotonic clock; the device stops by itself at the scene's end;
+//!    session's clock; the device stops by itself at the scene's end;
 //! 4. batches paced in real time (`pacing.rs`): the batch that starts at
 //!    item `j` is written at `start + t_j − lead`, never beyond the device's credit window; the
 //!    time of every write and how late it was are logged (pacing jitter). Items the device
@@ -29,7 +29,34 @@
 //! 5. Stop after the last sample (in mode (b) once the device reports serving it), which
 //!    confirms the end, then wait for Telemetry in the stopped state.
 //!
-//! A receive thread ([`rx`]) decodes the device's frames concurrently and counts damaged ones.
+//! **Time is injected.** The streaming core (the run: pacing, credit, resend, Served checks,
+//! Stop) never reads the operating system's clock: it reads and waits for time only through its
+//! [`Port`], which writes its frames, hands over the device's and owns a [`clock::Clock`]. What
+//! is fixed for a session once the device has answered (counts, rates, batch, lead, timeouts)
+//! is one plan set once; the run owns its mutable state. [`Session::run`] uses a
+//! [`SystemPort`]: the real port, a receive thread ([`rx`]) that decodes the device's frames
+//! concurrently and counts damaged ones, and the host's monotonic clock
+//! ([`clock::SystemClock`]). [`Session::run_with`] takes any port: a [`VirtualPort`] runs the
+//! firmware's link handler on a [`clock::VirtualClock`], with injected faults (a lost batch,
+//! credit withheld, a late wake), so a session's every time is exact and independent of the
+//! machine's load (`host/tests/stream_core.rs`).
+//!
+//! ```
+//! use margemu_hil::stream::clock::VirtualClock;
+//! use margemu_hil::stream::{Session, StreamConfig, VirtualPort};
+//! # let text = "duration = 0.1\nrate = 1000.0\nseed = 1\nmotion = \"kinematic\"\n";
+//! # let scene = margemu_sim::scene::Scene::parse_str(text, "doc.toml".as_ref()).unwrap();
+//! # let dir = std::env::temp_dir().join(format!("margemu-doc-virtual-{}", std::process::id()));
+//! # let _ = std::fs::remove_dir_all(&dir);
+//! let clock = VirtualClock::new();
+//! let device = VirtualPort::<256>::new(clock.clone(), 1_000_000); // polled every 1 ms
+//! let session = Session::new(&scene, StreamConfig::default(), &dir).unwrap();
+//! let summary = session.run_with(device, |_| {}).unwrap();
+//! assert_eq!(summary.served.byte_exact, 100);
+//! assert_eq!(summary.jitter.max_ns, 0); // every batch written at its instant, exactly
+//! # let _ = std::fs::remove_dir_all(&dir);
+//! ```
+//!
 //! Every sample instant the device reports serving (its Served messages: index, CRC-32C of the
 //! image latched) is logged in `served.csv` and checked against the prediction ([`served`]); the
 //! [`Summary`] carries the counts. The session stops with a [`StreamError`] on a device
@@ -38,6 +65,7 @@
 //! ([`log`], written by their own thread) are flushed and end with an `end` row in
 //! `events.csv`.
 
+pub mod clock;
 mod ending;
 mod flow;
 pub mod images;
@@ -47,6 +75,8 @@ mod logger;
 mod meta;
 pub mod model;
 mod pacing;
+mod plan;
+pub mod port;
 pub mod predictor;
 mod reports;
 pub mod resend;
@@ -54,6 +84,7 @@ pub mod rx;
 pub mod served;
 mod session;
 mod source;
+pub mod virtual_port;
 pub mod window;
 
 pub use images::{predict_images, ImageSettings, PredictedSample};
@@ -61,9 +92,11 @@ pub use lateness::Lateness;
 pub use model::{
     device_chip, kinematics_hold, model_images, predict_model, ModelPrediction, ModelSample,
 };
+pub use port::{Port, SystemPort};
 pub use predictor::Predictions;
 pub use served::{served_window, ServedCheck, ServedStats};
 pub use session::{rate_of, Session, SourceMode, StreamConfig};
+pub use virtual_port::VirtualPort;
 
 use margemu_protocol::link::{HelloAck, RxStats, Telemetry};
 use std::path::PathBuf;

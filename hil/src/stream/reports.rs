@@ -4,23 +4,23 @@
 //! and the errors that end a session (a Reset after the handshake, a fatal Error).
 
 use super::flow::Run;
+use super::port::Port;
 use super::rx::DeviceMessage;
 use super::{Progress, StreamError};
 use margemu_protocol::link::{
     Credit, DeviceState, ErrorCode, ErrorReport, HelloAck, ServedSample, Telemetry,
 };
-use std::io::Write;
-use std::time::Instant;
 
-impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
+impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
+    /// Logs and acts on a device message received at host time `at_ns`.
     pub(super) fn message(
         &mut self,
-        at: Instant,
+        at_ns: u64,
         seq: u16,
         message: DeviceMessage,
     ) -> Result<(), StreamError> {
-        let host_ns = self.host_ns(at);
-        let rate = self.session.rate;
+        let host_ns = Self::host_ns(at_ns);
+        let rate = self.plan.rate;
         let log = &mut self.session.log;
         let written = match &message {
             DeviceMessage::Telemetry(t) => {
@@ -56,16 +56,16 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
             DeviceMessage::Credit(c) => self.window(c),
             DeviceMessage::Telemetry(t) => {
                 self.window(t.credit());
-                self.telemetry = Some(t);
+                self.reports.telemetry = Some(t);
                 self.check_lost(&t)?;
             }
             DeviceMessage::HelloAck(a) if a.session == self.session.config.session_id => {
-                self.ack = Some(a);
+                self.reports.ack = Some(a);
             }
             DeviceMessage::HelloAck(_)
             | DeviceMessage::RegisterWrites { .. }
             | DeviceMessage::Served { .. } => {}
-            DeviceMessage::Reset(r) if self.ack.is_some() => {
+            DeviceMessage::Reset(r) if self.reports.ack.is_some() => {
                 return Err(StreamError::DeviceReset {
                     cause: format!("{:?}", r.cause),
                 })
@@ -89,7 +89,7 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
         first_time_ns: u64,
         samples: &[ServedSample],
     ) -> std::io::Result<()> {
-        let rate = self.session.rate;
+        let rate = self.plan.rate;
         let rows: Vec<_> = (first_index..)
             .zip(samples)
             .map(|(k, entry)| {
@@ -111,21 +111,19 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     /// written, nothing more is coming), and it was last written long enough before the report
     /// (see [`super::resend`]).
     fn check_lost(&mut self, t: &Telemetry) -> Result<(), StreamError> {
-        let capacity = self
-            .ack
-            .map_or(0, |a| u64::from(a.capabilities.buffer_capacity));
+        let capacity = self.plan.capacity;
         let contiguous = t
             .next_index
             .saturating_sub(t.credit_limit.saturating_sub(capacity));
-        let all_written = self.go_back.high() == self.session.stream_len();
+        let all_written = self.go_back.high() == self.plan.stream_len;
         let beyond = u64::from(t.buffer_level) > contiguous || all_written;
         let running = t.state == DeviceState::Running;
         let (Some(start), true, true, false) = (self.start, running, beyond, self.stop_sent) else {
             return Ok(());
         };
         let (next_index, tau) = (t.next_index, t.time_ns);
-        let margin = self.session.config.resend_after.as_nanos() as i64;
-        let seen_by = self.host_ns(start) + tau as i64 - margin;
+        let margin = self.plan.resend_after_ns as i64;
+        let seen_by = Self::host_ns(start) + tau as i64 - margin;
         match self.go_back.lost(next_index, seen_by) {
             Some(hole) if hole < self.next => {
                 let detail = format!(
@@ -149,8 +147,8 @@ impl<W: Write, P: FnMut(&Progress)> Run<'_, W, P> {
     }
 
     fn window(&mut self, c: Credit) {
-        self.credit = c;
-        self.credit_seen = true;
+        self.reports.credit = c;
+        self.reports.credit_seen = true;
     }
 }
 

@@ -16,7 +16,8 @@ use std::io::{self, Read};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, Sender};
 use std::sync::Arc;
-use std::time::Instant;
+
+use super::clock::Clock;
 
 /// A device → host message, owned.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,8 +55,8 @@ pub enum DeviceMessage {
 pub enum RxEvent {
     /// An intact frame with a device → host message.
     Message {
-        /// When it was decoded.
-        at: Instant,
+        /// When it was decoded, host time (ns since the session's origin).
+        at_ns: u64,
         /// Its sequence number.
         seq: u16,
         /// The message.
@@ -67,9 +68,10 @@ pub enum RxEvent {
     Closed(Option<io::Error>),
 }
 
-/// Spawns the reader thread over `port`.
+/// Spawns the reader thread over `port`; events are stamped with `clock`.
 pub fn spawn(
     mut port: impl Read + Send + 'static,
+    clock: impl Clock + 'static,
     shutdown: Arc<AtomicBool>,
 ) -> (Receiver<RxEvent>, std::thread::JoinHandle<()>) {
     let (tx, rx) = std::sync::mpsc::channel();
@@ -85,7 +87,7 @@ pub fn spawn(
                         return;
                     }
                     Ok(n) => {
-                        if decoder.feed(&buf[..n], &tx).is_err() {
+                        if decoder.feed(&buf[..n], clock.now_ns(), &tx).is_err() {
                             return; // the session is gone
                         }
                     }
@@ -118,11 +120,13 @@ pub struct Decoder {
 }
 
 impl Decoder {
-    /// Feeds received bytes; sends one event per message and one [`RxEvent::Stats`] per chunk
-    /// that changed the counters. Fails only when the receiving end of `tx` is gone.
+    /// Feeds bytes received at host time `at_ns`; sends one event per message and one
+    /// [`RxEvent::Stats`] per chunk that changed the counters. Fails only when the receiving end
+    /// of `tx` is gone.
     pub fn feed(
         &mut self,
         mut input: &[u8],
+        at_ns: u64,
         tx: &Sender<RxEvent>,
     ) -> Result<(), std::sync::mpsc::SendError<RxEvent>> {
         let before = self.stats;
@@ -142,7 +146,7 @@ impl Decoder {
                             self.stats.record_seq(event);
                             match owned(&repr.message) {
                                 Some(message) => tx.send(RxEvent::Message {
-                                    at: Instant::now(),
+                                    at_ns,
                                     seq: repr.seq,
                                     message,
                                 })?,
@@ -190,15 +194,6 @@ fn owned(message: &Message<'_>) -> Option<DeviceMessage> {
     })
 }
 
-/// Events already waiting, and a blocking receive with a deadline, in one place.
-pub(crate) fn recv_until(rx: &Receiver<RxEvent>, deadline: Instant) -> Option<RxEvent> {
-    let now = Instant::now();
-    if deadline <= now {
-        return rx.try_recv().ok();
-    }
-    rx.recv_timeout(deadline - now).ok()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -217,8 +212,8 @@ mod tests {
         bytes.extend_from_slice(&wire[..n]);
         let (tx, rx) = std::sync::mpsc::channel();
         let mut decoder = Decoder::default();
-        decoder.feed(&bytes[..5], &tx).unwrap();
-        decoder.feed(&bytes[5..], &tx).unwrap();
+        decoder.feed(&bytes[..5], 0, &tx).unwrap();
+        decoder.feed(&bytes[5..], 0, &tx).unwrap();
         let events: Vec<RxEvent> = rx.try_iter().collect();
         // The garbage ends at the frame's leading 0x00: one damaged frame, reported first.
         assert!(

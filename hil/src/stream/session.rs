@@ -1,13 +1,14 @@
 //! [`Session`]: the host side of one streaming run (handshake, configuration, prefill, paced
 //! batches, stop), over any byte port.
 
+use super::clock::SystemClock;
 use super::flow::Run;
 use super::images::{predict_images, ImageSettings};
 use super::log::{SessionLog, SENT_COLUMNS, SENT_KINEMATICS_COLUMNS};
 use super::logger::Logger;
 use super::meta::metadata;
 use super::model::predict_model;
-use super::rx;
+use super::port::{Port, SystemPort};
 use super::source::{Items, Prediction};
 use super::{Progress, StreamError, Summary};
 use margemu_protocol::link::Rate;
@@ -16,7 +17,7 @@ use margemu_sim::scene::chip::ChipSetup;
 use margemu_sim::scene::Scene;
 use std::io::{Read, Write};
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -203,25 +204,38 @@ impl Session {
     }
 
     /// Runs the session: `reader` and `writer` are the two directions of the port (`reader` must
-    /// return from `read` now and then, by data, timeout or end of file). `progress` is called
-    /// about ten times a second. Whatever the outcome, the logs are flushed, `events.csv` ends
-    /// with an `end` row saying how the session ended, and `meta.toml` gets its completion
-    /// record (complete, interrupted or failed; [`margemu_sim::rundir`]) once every other writer of
-    /// the directory has let go of its share ([`Session::completion_record`]).
+    /// return from `read` now and then, by data, timeout or end of file), on the host's
+    /// monotonic clock ([`SystemClock`], host time 0 when the run begins unless
+    /// [`Session::set_origin`]). `progress` is called about ten times a second of that clock.
+    /// Whatever the outcome, the logs are flushed, `events.csv` ends with an `end` row saying
+    /// how the session ended, and `meta.toml` gets its completion record (complete, interrupted
+    /// or failed; [`margemu_sim::rundir`]) once every other writer of the directory has let go of its
+    /// share ([`Session::completion_record`]).
     pub fn run(
-        mut self,
+        self,
         reader: impl Read + Send + 'static,
         writer: impl Write,
         progress: impl FnMut(&Progress),
     ) -> Result<Summary, StreamError> {
-        let shutdown = Arc::new(AtomicBool::new(false));
-        let (events, _thread) = rx::spawn(reader, shutdown.clone());
-        let mut run = Run::new(&mut self, writer, events, progress);
+        let clock = self
+            .origin
+            .map_or_else(SystemClock::new, SystemClock::with_origin);
+        self.run_with(SystemPort::new(reader, writer, clock), progress)
+    }
+
+    /// [`Session::run`] on any [`Port`]: every host time the session waits for or logs comes
+    /// from the port's clock (e.g. a [`VirtualPort`](super::virtual_port::VirtualPort) on a
+    /// virtual clock). The port is dropped before the logs are closed.
+    pub fn run_with(
+        mut self,
+        port: impl Port,
+        progress: impl FnMut(&Progress),
+    ) -> Result<Summary, StreamError> {
+        let mut run = Run::new(&mut self, port, progress);
         let result = run.session_flow();
-        let end_ns = run.host_ns(Instant::now());
+        let end_ns = run.now() as i64;
         let summary = run.summary();
         drop(run);
-        shutdown.store(true, Ordering::Relaxed);
         let (status, ended) = match &result {
             Ok(()) => (Status::Complete, "completed".to_string()),
             Err(e @ StreamError::Interrupted) => (Status::Interrupted, e.to_string()),

@@ -1,0 +1,158 @@
+//! [`Plan`]: everything a streaming session keeps fixed once the device has answered Hello (the
+//! scene's counts and rates, the batch size and lead the device's capabilities allow, the
+//! timeouts), set once by the run and never changed; the run's mutable state lives in `Run`.
+//!
+//! Items are written in batches of up to `StreamConfig::batch`, capped by the frame, by the
+//! device's `max_batch` and by a quarter of its buffer. The lead is `StreamConfig::lead` capped
+//! at 3/8 of the device's buffer (so a due batch normally finds the credit it needs: the device
+//! grants its window a quarter of its buffer at a time).
+
+use super::session::Session;
+use margemu_protocol::link::{HelloAck, Rate};
+use std::time::Duration;
+
+/// The fixed parameters of a session (see the module docs). Times are ns.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Plan {
+    /// Output samples in the scene.
+    pub(super) samples: u64,
+    /// Items to stream (output samples, or kinematics samples in source model).
+    pub(super) stream_len: u64,
+    /// The scene's output rate.
+    pub(super) rate: Rate,
+    /// The rate of the items.
+    pub(super) item_rate: Rate,
+    /// Output samples per item.
+    pub(super) hold: u64,
+    /// The device stops at once on Stop (source model) rather than serving what it holds.
+    pub(super) stops_at_once: bool,
+    /// Items per batch.
+    pub(super) batch: u64,
+    /// How far ahead of its first item's instant a batch is due.
+    pub(super) lead_ns: u64,
+    /// The device's buffer, items (0 before the handshake).
+    pub(super) capacity: u64,
+    /// The last stretch before a due instant that is busy-waited.
+    pub(super) spin_ns: u64,
+    /// How long to wait for HelloAck and for the first credit window.
+    pub(super) hello_timeout_ns: u64,
+    /// How long a due batch may wait for credit.
+    pub(super) credit_timeout: Duration,
+    /// How long to wait for the last sample served and for the Stop confirmed.
+    pub(super) drain_ns: u64,
+    /// How long after its last write an item the device reports lost may be written again.
+    pub(super) resend_after_ns: u64,
+}
+
+impl Plan {
+    /// The plan before the device has answered: one item per batch, no lead, no buffer.
+    pub(super) fn before_handshake(session: &Session) -> Self {
+        let c = &session.config;
+        let ns = |d: Duration| d.as_nanos() as u64;
+        Self {
+            samples: session.samples,
+            stream_len: session.stream_len(),
+            rate: session.rate,
+            item_rate: session.item_rate(),
+            hold: session.hold(),
+            stops_at_once: session.stops_at_once(),
+            batch: 1,
+            lead_ns: 0,
+            capacity: 0,
+            spin_ns: ns(c.spin),
+            hello_timeout_ns: ns(c.hello_timeout),
+            credit_timeout: c.credit_timeout,
+            drain_ns: ns(c.drain_timeout),
+            resend_after_ns: ns(c.resend_after),
+        }
+    }
+
+    /// The plan for a device that answered `ack` (a device without one is planned as one of
+    /// batch 1 and buffer 4).
+    pub(super) fn new(session: &Session, ack: Option<&HelloAck>) -> Self {
+        let (max_batch, capacity) = ack.map_or((1, 4), |a| {
+            let c = a.capabilities;
+            (usize::from(c.max_batch), c.buffer_capacity as usize)
+        });
+        let batch = session
+            .config
+            .batch
+            .min(max_batch)
+            .min(session.max_per_frame())
+            .min(capacity / 4)
+            .max(1);
+        let window = session.item_rate().sample_time_ns(3 * capacity as u64 / 8);
+        let lead = session.config.lead.min(Duration::from_nanos(window));
+        Self {
+            batch: batch as u64,
+            lead_ns: lead.as_nanos() as u64,
+            capacity: capacity as u64,
+            ..Self::before_handshake(session)
+        }
+    }
+
+    /// Host time at which the batch starting at item `j` is due, for a Start written at host
+    /// time `start`: `start + t_j − lead`, never before `start`.
+    pub(super) fn due(&self, start: u64, j: u64) -> u64 {
+        let t = self.item_rate.sample_time_ns(j);
+        (start + t).saturating_sub(self.lead_ns).max(start)
+    }
+
+    /// Host time at which Stop is due, for a Start written at host time `start`: half an output
+    /// period after the last sample's instant (`None` for an empty scene).
+    pub(super) fn stop_at(&self, start: u64) -> Option<u64> {
+        let last = self.samples.checked_sub(1)?;
+        let (t_last, t_next) = (
+            self.rate.sample_time_ns(last),
+            self.rate.sample_time_ns(self.samples),
+        );
+        Some(start + t_last + (t_next - t_last) / 2)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(samples: u64, rate: Rate) -> Plan {
+        Plan {
+            samples,
+            stream_len: samples,
+            rate,
+            item_rate: rate,
+            hold: 1,
+            stops_at_once: false,
+            batch: 32,
+            lead_ns: 96_000_000,
+            capacity: 256,
+            spin_ns: 0,
+            hello_timeout_ns: 0,
+            credit_timeout: Duration::ZERO,
+            drain_ns: 0,
+            resend_after_ns: 0,
+        }
+    }
+
+    #[test]
+    fn batches_are_due_a_lead_ahead_and_never_before_start() {
+        let p = plan(1000, Rate::new(1000, 1).unwrap());
+        assert_eq!(p.due(5, 0), 5);
+        assert_eq!(p.due(5, 96), 5);
+        assert_eq!(p.due(5, 97), 5 + 1_000_000);
+        assert_eq!(p.due(5, 200), 5 + 104_000_000);
+    }
+
+    #[test]
+    fn stop_is_due_half_a_period_after_the_last_instant() {
+        assert_eq!(
+            plan(1000, Rate::new(1000, 1).unwrap()).stop_at(5),
+            Some(5 + 999_500_000)
+        );
+        // 3 Hz: instants 0, 333 333 333, 666 666 666 ns, then 1 s.
+        assert_eq!(
+            plan(3, Rate::new(3, 1).unwrap()).stop_at(0),
+            Some(833_333_333)
+        );
+        assert_eq!(plan(0, Rate::new(3, 1).unwrap()).stop_at(0), None);
+    }
+}
