@@ -72,15 +72,33 @@ pub struct PerturbationSpec {
 }
 
 impl Default for PerturbationSpec {
+    /// The model's defaults ([`PerturbationConfig::default`], the paper's setting), spelled as
+    /// the scene spells them.
     fn default() -> Self {
+        Self::from(&PerturbationConfig::default())
+    }
+}
+
+impl From<&PerturbationConfig> for PerturbationSpec {
+    /// The scene table that [`PerturbationSpec::config`] turns back into `config`.
+    fn from(config: &PerturbationConfig) -> Self {
+        let (scaling, amplitude) = match config.amplitude {
+            Amplitude::Uniform { lo, hi } => (Scaling::Uniform, [lo, hi]),
+            Amplitude::Reference => (Scaling::Reference, [0.0, 4.0]),
+        };
+        let (placement, direction) = match config.placement {
+            Placement::PerAxis => (PlacementSpec::PerAxis, None),
+            Placement::Direction(d) => (PlacementSpec::Direction, Some(d)),
+            Placement::RandomDirection => (PlacementSpec::RandomDirection, None),
+        };
         Self {
-            window: 2.0,
-            cutoff: 5.0,
-            scaling: Scaling::Uniform,
-            amplitude: [0.0, 4.0],
-            gap: [1.0, 5.0],
-            placement: PlacementSpec::PerAxis,
-            direction: None,
+            window: config.window_s,
+            cutoff: config.cutoff_hz,
+            scaling,
+            amplitude,
+            gap: config.gap_s,
+            placement,
+            direction,
         }
     }
 }
@@ -236,6 +254,27 @@ pub(crate) fn key_path(what: &str) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn perturbation_table_round_trips_the_model_configuration() {
+        assert_eq!(
+            PerturbationSpec::default().config(),
+            PerturbationConfig::default()
+        );
+        for placement in [
+            Placement::Direction([0.0, 0.6, 0.8]),
+            Placement::RandomDirection,
+        ] {
+            let config = PerturbationConfig {
+                window_s: 1.5,
+                cutoff_hz: 3.0,
+                amplitude: Amplitude::Reference,
+                gap_s: [0.5, 2.0],
+                placement,
+            };
+            assert_eq!(PerturbationSpec::from(&config).config(), config);
+        }
+    }
 
     #[test]
     fn model_parameter_names_map_to_scene_keys() {
