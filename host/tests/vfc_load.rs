@@ -61,10 +61,10 @@ fn session(scene: &Scene, params: &FilterParams, dir: &Path) -> (FcReport, f64) 
         output: OutputRate::EverySample,
         ..VfcConfig::for_scene(scene, params.clone())
     };
-    // A long lead, so the session itself does not underrun on a loaded machine.
+    // The demo's stream settings.
     let stream = StreamConfig {
         port: "pty".into(),
-        lead: std::time::Duration::from_secs(1),
+        lead: margemu::demo::DEMO_LEAD,
         ..StreamConfig::default()
     };
     let run = run_loopback(scene, config, stream, dir, &AtomicBool::new(false), |_| {}).unwrap();
