@@ -1,20 +1,14 @@
-//! From the driver's readings to one body frame in SI units, as a flight controller's sensor
+//! The body frame, and how a magnetometer's axes map into it, as a flight controller's sensor
 //! layer does it.
 //!
-//! The `mpu9250` crate (0.25) returns, whatever its docs say (see `tests/driver_mpu9250.rs`):
-//! the accelerometer in m/s² (on its own `G = 9.807`), the gyroscope in rad/s, and the
-//! magnetometer in **milligauss**, ASA-adjusted, in the **AK8963's own axes**. The body frame is
-//! the MPU-9250's accel/gyro frame (the chip is mounted with the plate's axes), so the
-//! magnetometer is turned into it with a [`MagAlignment`], the equivalent of a flight
-//! controller's "mag alignment" setting. In the MPU-9250 package the AK8963's x is the
-//! accelerometer's y, its y the accelerometer's x, and its z points the other way (datasheet
-//! PS-MPU-9250A section 9.1), so the alignment of this board is [`MagAlignment::MPU9250`]:
-//! body = (ak_y, ak_x, −ak_z).
-//!
-//! The driver's own scale constants stay as they are (its gyro is 550–977 ppm off the
-//! datasheet's sensitivity, its accelerometer 36 ppm): a flight controller built on this crate
-//! sees exactly these values.
+//! The body frame is the accel/gyro frame of the chip (the chip is mounted with the plate's
+//! axes). A magnetometer with axes of its own is turned into it with a [`MagAlignment`], the
+//! equivalent of a flight controller's "mag alignment" setting. The default,
+//! [`MagAlignment::mpu9250`], is not a copy of the AK8963's mounting: it is read off the chip
+//! module's own mapping ([`mag_axes_to_mpu`]), the one place that fact lives. Other alignments
+//! (parsed from `y,x,-z`-style text) show what a wrong setting costs.
 
+use margemu_protocol::regmap::mpu6xxx::convert::mag_axes_to_mpu;
 use std::fmt;
 use std::str::FromStr;
 
@@ -36,8 +30,20 @@ const fn axis(axis: usize, negate: bool) -> SignedAxis {
 }
 
 impl MagAlignment {
-    /// The AK8963 inside an MPU-9250: body = (ak_y, ak_x, −ak_z).
-    pub const MPU9250: Self = Self([axis(1, false), axis(0, false), axis(2, true)]);
+    /// The AK8963 inside an MPU-9250, as the chip module maps it ([`mag_axes_to_mpu`]): each
+    /// body axis is where that mapping sends one AK8963 axis.
+    pub fn mpu9250() -> Self {
+        let mut out = [axis(0, false); 3];
+        for i in 0..3 {
+            let mut unit = [0i8; 3];
+            unit[i] = 1;
+            let body = mag_axes_to_mpu(unit);
+            if let Some(j) = body.iter().position(|&v| v != 0) {
+                out[j] = axis(i, body[j] < 0);
+            }
+        }
+        Self(out)
+    }
     /// No turn: the sensor's axes taken as the body's (wrong for an MPU-9250; a test uses it to
     /// show the error a flight controller makes without the alignment).
     pub const IDENTITY: Self = Self([axis(0, false), axis(1, false), axis(2, false)]);
@@ -50,8 +56,9 @@ impl MagAlignment {
 }
 
 impl Default for MagAlignment {
+    /// [`MagAlignment::mpu9250`].
     fn default() -> Self {
-        Self::MPU9250
+        Self::mpu9250()
     }
 }
 
@@ -114,22 +121,6 @@ pub struct BodySample {
     pub mag_ut: [f64; 3],
 }
 
-/// The driver's readings (its units, see the module docs) in body axes and SI units.
-pub fn to_body(
-    accel: [f32; 3],
-    gyro: [f32; 3],
-    mag_mgauss: [f32; 3],
-    alignment: &MagAlignment,
-) -> BodySample {
-    let wide = |v: [f32; 3]| v.map(f64::from);
-    BodySample {
-        gyro: wide(gyro),
-        acc: wide(accel),
-        // 1 µT = 10 mG.
-        mag_ut: alignment.apply(wide(mag_mgauss).map(|m| m * 0.1)),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -139,33 +130,24 @@ mod tests {
     fn mpu9250_alignment_undoes_the_chips_axis_swap() {
         let body = [3.0f32, -5.0, 7.0];
         let ak = mag_axes_from_mpu(body);
-        let back = MagAlignment::MPU9250.apply(ak.map(f64::from));
+        let back = MagAlignment::mpu9250().apply(ak.map(f64::from));
         assert_eq!(back, body.map(f64::from));
         assert_ne!(MagAlignment::IDENTITY.apply(ak.map(f64::from)), back);
     }
 
     #[test]
     fn alignments_parse_and_print() {
-        assert_eq!("y,x,-z".parse::<MagAlignment>(), Ok(MagAlignment::MPU9250));
+        assert_eq!(
+            "y,x,-z".parse::<MagAlignment>(),
+            Ok(MagAlignment::mpu9250())
+        );
         assert_eq!(
             " x, +y ,z".parse::<MagAlignment>(),
             Ok(MagAlignment::IDENTITY)
         );
-        assert_eq!(MagAlignment::MPU9250.to_string(), "y,x,-z");
+        assert_eq!(MagAlignment::mpu9250().to_string(), "y,x,-z");
         for bad in ["x,y", "x,x,z", "x,y,w", "x,y,--z", ""] {
             assert!(bad.parse::<MagAlignment>().is_err(), "{bad}");
         }
-    }
-
-    #[test]
-    fn milligauss_become_microtesla_in_body_axes() {
-        let s = to_body(
-            [0.0, 0.0, 9.8],
-            [0.1, 0.2, 0.3],
-            [100.0, 200.0, 300.0],
-            &MagAlignment::MPU9250,
-        );
-        assert_eq!(s.mag_ut, [20.0, 10.0, -30.0]);
-        assert_eq!(s.acc[2], f64::from(9.8f32));
     }
 }

@@ -6,10 +6,10 @@
 //!    ([`Board::init`]) and checks that the chip now converts samples the way the host
 //!    predicted its images; a mismatch ends the device loop with the reason (the session then
 //!    fails with it). A new Hello (the device back to idle) starts over.
-//! 2. At each turn, the INT pin: when it says data ready, the driver reads what is waiting
-//!    (clearing INT): one sample on the MPU-9250, every FIFO packet on the ICM-42688-P. The
-//!    board turns each into SI body axes ([`Board::to_body`]), and the filter takes it with
-//!    `dt` = the time since the previous sample's data-ready edge. On a chip with a
+//! 2. At each turn, the INT pin: when it says data ready, the board reads every sample waiting
+//!    in the chip's FIFO, oldest first (clearing INT; see [`board`] for each chip's FIFO). The
+//!    board turns each into SI body axes ([`Board::to_body`]), and the filter takes every one,
+//!    in order, with `dt` = the time between their instants (below). On a chip with a
 //!    magnetometer the filter starts with the first sample that carries a measurement (the
 //!    AK8963 delivers its first one a period of its own after set-up; a start without it would
 //!    take yaw 0); the samples before are counted as warm-up.
@@ -27,15 +27,19 @@
 //!    ATTITUDE and an ATTITUDE_QUATERNION (MAVLink 2, [`crate::dut::mavlink_out`]) with `time_boot_ms` =
 //!    the sample's instant; a HEARTBEAT every second. Frames go to the UART queue.
 //!
-//! **Time.** The flight controller's clock is the device's scene clock: a data-ready edge
-//! happens when the device latches a sample, at that sample's scene instant
-//! ([`Device::last_served`](margemu_firmware::link::Device::last_served)), which is what an edge
-//! interrupt would timestamp. The loop polls the pin, so reads come up to one turn (about 1 ms)
-//! after the edge; when the host starves the device thread for longer than a sample period, a
-//! sample latched over before it was read is lost to the flight controller, as on a board that
-//! misses an interrupt, and counted in [`FcReport::missed`] (the filter's `dt` spans the gap).
-//! A FIFO keeps such samples: the newest packet read is the last sample served, each older one
-//! a sample period earlier. Only a FIFO overflow (flushed, [`FcReport::overflows`]) loses them.
+//! **Time.** The flight controller's clock is the device's scene clock. A sample's instant
+//! comes from its index in the FIFO's stream at the configured rate: the first batch after
+//! set-up anchors the stream (its newest sample is the one the device served last,
+//! [`Device::last_served`](margemu_firmware::link::Device::last_served), each older one a period
+//! earlier), and sample `k` is then `k` periods after the first, whenever the thread got to read
+//! it. So a flight controller whose thread is starved reads the same samples with the same
+//! instants, only later, and feeds its filter exactly what it would have on an idle machine.
+//! Only a FIFO overflow (the thread starved for a whole FIFO: 24 samples on the MPU-9250, 102 on
+//! the ICM-42688-P) loses samples: the board resets the FIFO and counts it
+//! ([`FcReport::overflows`]), the clock is anchored again on the next batch, and the gap is
+//! counted in [`FcReport::missed`] (the filter's `dt` spans it). A batch whose newest instant
+//! disagrees with the device's by more than half a period (samples lost without an overflow)
+//! anchors the clock again too, and is counted ([`FcReport::resyncs`]).
 
 use super::axes::BodySample;
 use super::board::{self, Board};
@@ -69,17 +73,19 @@ pub struct FcReport {
     pub init: Option<board::InitReport>,
     /// Set-ups done.
     pub inits: u64,
-    /// Samples read on data ready.
+    /// Samples read from the FIFO.
     pub samples: u64,
     /// Samples read before the first magnetometer measurement (not filtered; chips with a
     /// magnetometer only).
     pub warmup: u64,
-    /// Samples never read: latched over by the next one before the flight controller saw its
-    /// data-ready, or flushed with an overflowing FIFO (from the gaps between the instants of
-    /// the samples read).
+    /// Samples never read: flushed with an overflowing FIFO (from the gaps between the
+    /// instants of the samples read).
     pub missed: u64,
     /// FIFO overflows (each flushed the FIFO).
     pub overflows: u64,
+    /// Times the sample clock disagreed with the device's last served instant and started
+    /// again (0 unless samples were lost without an overflow).
+    pub resyncs: u64,
     /// Frames queued per MAVLink message name.
     pub sent: BTreeMap<&'static str, u64>,
     /// Frames dropped because the UART queue was full.
@@ -107,6 +113,9 @@ pub struct VirtualFc {
     last_ns: Option<u64>,
     /// Instant of the previous sample read, ns.
     last_read_ns: Option<u64>,
+    /// The instants of the samples read, by their index in the FIFO's stream (`None` until the
+    /// first batch after set-up or after an overflow).
+    clock: Option<SampleClock>,
     /// Index of the next output instant (for [`OutputRate::Hz`]).
     next_out: u64,
     next_heartbeat_ns: u64,
@@ -144,6 +153,7 @@ impl VirtualFc {
             filter,
             last_ns: None,
             last_read_ns: None,
+            clock: None,
             next_out: 0,
             next_heartbeat_ns: 0,
             mavlink: MavlinkWriter::v2(),
@@ -176,11 +186,12 @@ impl VirtualFc {
         let Some(board) = &mut self.board else {
             return Ok(());
         };
-        let t_ns = device.last_served().map_or(0, |s| s.time_ns);
+        let last_served_ns = device.last_served().map_or(0, |s| s.time_ns);
         let chip: &mut EmulatedChip = device.chip_mut();
         if !board.data_ready(chip)? {
             return Ok(());
         }
+        let overflows_before = board.overflows();
         let readings = board
             .read(chip)
             .map_err(|e| format!("reading the chip: {e}"))?;
@@ -190,14 +201,31 @@ impl VirtualFc {
             .iter()
             .map(|r| board.to_body(r, &self.config.mag_alignment))
             .collect();
-        self.update(|r| r.overflows = overflows);
+        if overflows != overflows_before {
+            // Samples were lost: the index clock starts again from the next batch.
+            self.clock = None;
+            self.update(|r| r.overflows = overflows);
+        }
+        let Some(n) = u64::try_from(bodies.len()).ok().filter(|&n| n > 0) else {
+            return Ok(());
+        };
         let period_ns = 1e9 / self.config.sample_rate_hz;
-        let n = bodies.len();
-        for (i, body) in bodies.into_iter().enumerate() {
-            // The newest sample read is the last one served; a FIFO's older ones came a
-            // period apart before it.
-            let back_ns = ((n - 1 - i) as f64 * period_ns).round() as u64;
-            self.take(t_ns.saturating_sub(back_ns), body, with_mag);
+        let anchored = SampleClock::anchored(last_served_ns, n, period_ns);
+        let mut clock = self.clock.unwrap_or(anchored);
+        let mut times: Vec<u64> = (0..n).map(|_| clock.next_ns()).collect();
+        // The newest sample read is the last one the device served: if the index clock says
+        // otherwise, samples were lost or doubled unseen; the clock starts again from this batch.
+        if times
+            .last()
+            .is_some_and(|&t| t.abs_diff(last_served_ns) as f64 > period_ns / 2.0)
+        {
+            clock = anchored;
+            times = (0..n).map(|_| clock.next_ns()).collect();
+            self.update(|r| r.resyncs += 1);
+        }
+        self.clock = Some(clock);
+        for (t_ns, body) in times.into_iter().zip(bodies) {
+            self.take(t_ns, body, with_mag);
         }
         Ok(())
     }
@@ -260,6 +288,7 @@ impl VirtualFc {
             .map_err(|e| e.to_string())?;
         self.last_ns = None;
         self.last_read_ns = None;
+        self.clock = None;
         self.next_out = 0;
         self.next_heartbeat_ns = 0;
         self.update(|r| {
@@ -318,6 +347,35 @@ impl VirtualFc {
     }
 }
 
+/// The instants of the samples read from a FIFO: sample `k` of the stream is `first + k`
+/// periods after the first (rounded to the ns), whenever the flight controller got to read it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct SampleClock {
+    first_ns: u64,
+    period_ns: f64,
+    next: u64,
+}
+
+impl SampleClock {
+    /// The clock of a stream whose first batch holds `n` samples, the newest served at
+    /// `newest_ns`.
+    fn anchored(newest_ns: u64, n: u64, period_ns: f64) -> Self {
+        let back_ns = ((n - 1) as f64 * period_ns).round() as u64;
+        Self {
+            first_ns: newest_ns.saturating_sub(back_ns),
+            period_ns,
+            next: 0,
+        }
+    }
+
+    /// The next sample's instant.
+    fn next_ns(&mut self) -> u64 {
+        let t = self.first_ns + (self.next as f64 * self.period_ns).round() as u64;
+        self.next += 1;
+        t
+    }
+}
+
 fn heartbeat() -> MavMessage {
     MavMessage::HEARTBEAT(HEARTBEAT_DATA {
         custom_mode: 0,
@@ -362,9 +420,10 @@ impl std::fmt::Display for FcReport {
             self.samples,
             self.warmup,
             self.missed,
-            match self.overflows {
-                0 => String::new(),
-                n => format!(" ({n} FIFO overflows)"),
+            match (self.overflows, self.resyncs) {
+                (0, 0) => String::new(),
+                (n, 0) => format!(" ({n} FIFO overflows)"),
+                (n, r) => format!(" ({n} FIFO overflows, {r} clock resyncs)"),
             },
             if sent.is_empty() { "nothing".into() } else { sent.join(", ") },
             self.dropped,

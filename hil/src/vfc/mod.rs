@@ -11,15 +11,16 @@
 //! - [`board`]: one board per chip model, chosen by the model of the device's chip. On the
 //!   MPU-9250 ([`board::mpu9250`]) the unmodified `mpu9250` crate initialises the chip (reset,
 //!   WHO_AM_I, ±16 g, ±2000 °/s, DLPF, sample-rate divider, the AK8963 through the driver's own
-//!   path), latches INT on data ready, and reads accelerometer, gyroscope and magnetometer in
-//!   one burst (SPI). On the ICM-42688-P
-//!   ([`board::icm42688p`]) the unmodified `icm426xx` crate initialises the chip (reset,
-//!   WHO_AM_I, ±16 g, ±2000 °/s, the scene's ODR, 20-bit FIFO packets, INT1 on the FIFO
-//!   watermark) and the board drains the FIFO on INT1 (SPI). Every value comes from the chip's
-//!   registers through margemu's embedded-hal adapters, never from the host's predicted
-//!   samples;
-//! - [`axes`]: the body frame, and the MPU-9250 driver's units to SI with the AK8963's axes
-//!   turned into the body frame ([`MagAlignment`]); each board maps its own chip's axes;
+//!   path), then the board latches INT on data ready and sets the FIFO up with raw register
+//!   writes on the same bus (the auxiliary master's slave 0 reads the AK8963 into it), and reads
+//!   every sample from the FIFO as ArduPilot's Invensense driver does (SPI). On the ICM-42688-P ([`board::icm42688p`]) the unmodified `icm426xx`
+//!   crate initialises the chip (reset, WHO_AM_I, ±16 g, ±2000 °/s, the scene's ODR, 20-bit
+//!   FIFO packets, INT1 on the FIFO watermark) and the board drains the FIFO on INT1 through
+//!   the driver (SPI). Every value comes from the chip's registers through margemu's
+//!   embedded-hal adapters, never from the host's predicted samples, and is converted by the
+//!   chip module (`margemu_protocol::regmap`) or the driver, never by the board;
+//! - [`axes`]: the body frame, and the magnetometer's axes turned into it ([`MagAlignment`], by
+//!   default the chip module's own mapping of the AK8963);
 //! - the filter: ECF, GDA or EKF of `margemu-filters` in `f64`, with the parameters of
 //!   [`margemu_sim::filter_params::FilterParams`] (defaults, or a parameters file as `margemu tune` writes
 //!   it), starting from its first sample;

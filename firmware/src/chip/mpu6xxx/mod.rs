@@ -132,6 +132,8 @@ pub struct Mpu6xxx {
     gyro_clock: SensorClock,
     /// FIFO count as latched by the last FIFO_COUNTH read.
     fifo_count_latch: u16,
+    /// Whether a sample was latched since power-on (see [`Mpu6xxx::advance`]).
+    latched: bool,
     aux: AuxState,
     ak: Option<Ak8963>,
     now_ns: u64,
@@ -169,6 +171,7 @@ impl Mpu6xxx {
             accel_clock: SensorClock::default(),
             gyro_clock: SensorClock::default(),
             fifo_count_latch: 0,
+            latched: false,
             aux: AuxState::default(),
             ak,
             now_ns: 0,
@@ -315,10 +318,17 @@ impl Mpu6xxx {
         self.now_ns.saturating_add(self.sample_period_ns())
     }
 
-    /// Moves the chip's clock to `now_ns` without a new sample (ends INT pulses, lets the
-    /// AK8963 measure the field it last saw).
+    /// Moves the chip's clock to `now_ns` without a new sample (ends INT pulses). Before the
+    /// first latch it lets the AK8963 measure the field it last saw. Once samples are latched,
+    /// the field up to the next latch is that latch's (an image carries the field at its
+    /// instant), so a measurement due between two latches completes at the next one, with its
+    /// field: what the chip holds after a latch never depends on when, between latches, the
+    /// board happened to call this.
     pub fn advance(&mut self, now_ns: u64) {
         self.now_ns = self.now_ns.max(now_ns);
+        if self.latched {
+            return;
+        }
         if let Some(ak) = &mut self.ak {
             let source = ak.held_source();
             ak.advance(self.now_ns, source);

@@ -66,6 +66,7 @@ impl Mpu6xxx {
         sensor_rates: bool,
     ) {
         self.now_ns = self.now_ns.max(now_ns);
+        self.latched = true;
         if let Some(ak) = &mut self.ak {
             ak.advance(self.now_ns, mag);
         }

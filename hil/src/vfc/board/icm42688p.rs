@@ -14,7 +14,8 @@
 //! **Reading.** [`Board::data_ready`] is INT1's level. [`Board::read`] drains the FIFO with the
 //! driver's `read_sample` (one SPI burst: INT_STATUS, FIFO_COUNT, one 20-byte packet) until it
 //! says no packet is left, so a flight controller that was late for a data-ready loses nothing:
-//! the FIFO kept the samples. The driver scales the 20-bit values itself, as fixed ±16 g and
+//! the FIFO kept the samples, and the flight controller stamps each from its index in the
+//! stream ([`crate::vfc::fc`]). The driver scales the 20-bit values itself, as fixed ±16 g and
 //! ±2000 °/s over 2^19 codes: exact for the accelerometer (32768 LSB/g, the emulated chip's
 //! 8192 LSB/g on bits 19:2), 550 ppm low for the gyroscope (262.144 codes per °/s where the chip
 //! has 262, its 131 LSB/(°/s) on bits 19:1). A flight controller built on this crate sees
@@ -26,7 +27,9 @@
 //! ones once full (the device thread starved for 102 sample periods: 0.1 s at 1 kHz). The driver
 //! then reports `FifoOverflow` (having consumed one packet); the board flushes the FIFO through
 //! the driver's `reset_fifo`, as its docs advise, returns no samples, and counts the overflow:
-//! the flight controller counts the gap as missed samples.
+//! the flight controller counts the gap as missed samples. (ArduPilot's v3 driver,
+//! `libraries/AP_InertialSensor/AP_InertialSensor_Invensensev3.cpp`, reads this chip's FIFO the
+//! same way: FIFO_COUNT, a burst of packets, a FIFO reset on overflow.)
 //!
 //! **Axes.** The body frame is the chip's accel/gyro frame (the chip is mounted with the
 //! plate's axes, as the MPU-9250 is); there is no magnetometer ([`to_body`]).

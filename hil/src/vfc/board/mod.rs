@@ -4,15 +4,16 @@
 //!
 //! | model       | board            | driver            | bus            | magnetometer      |
 //! |-------------|------------------|-------------------|----------------|-------------------|
-//! | MPU-9250    | [`mpu9250`]      | `mpu9250` 0.25    | SPI (or I2C)   | AK8963, in the burst |
+//! | MPU-9250    | [`mpu9250`]      | `mpu9250` 0.25    | SPI (or I2C)   | AK8963, in the FIFO |
 //! | ICM-42688-P | [`icm42688p`]    | `icm426xx` 0.4    | SPI            | none              |
 //!
 //! [`Board`] is the chip-generic face the flight controller ([`super::fc`]) sees:
 //! [`Board::init`] sets the device's chip up through the driver and says how the chip now
 //! converts samples ([`Setup::configured`], checked against the host's images);
-//! [`Board::data_ready`] reads the INT pin like a GPIO; [`Board::read`] returns the samples
-//! waiting, oldest first, in the chip's axes ([`Reading`]); [`Board::to_body`] is the board's
-//! own axis mapping to the body frame. [`chip_settings`] is what the host must compute its
+//! [`Board::data_ready`] reads the INT pin like a GPIO; [`Board::read`] returns every sample
+//! waiting in the chip's FIFO, oldest first, in the chip's axes ([`Reading`], converted by the
+//! chip module or the driver, never by the board); [`Board::to_body`] maps them to the body
+//! frame. [`chip_settings`] is what the host must compute its
 //! images with for a model (the full scales the model's driver sets).
 //!
 //! **The chip belongs to the device.** The firmware's link handler owns the chip and latches
@@ -164,21 +165,21 @@ impl Board {
         }
     }
 
-    /// Reads the samples waiting, oldest first, through the driver (which clears INT): one
-    /// burst on the MPU-9250, the whole FIFO on the ICM-42688-P (empty after a FIFO overflow,
-    /// see [`icm42688p::Board::read`]).
+    /// Reads the samples waiting in the chip's FIFO, oldest first (the read clears INT): raw
+    /// FIFO bursts on the MPU-9250 ([`mpu9250::Board::read`]), the driver's on the ICM-42688-P
+    /// ([`icm42688p::Board::read`]); empty after a FIFO overflow, which is counted.
     pub fn read(&mut self, chip: &mut EmulatedChip) -> Result<Vec<Reading>, String> {
         match (&mut *self, &mut *chip) {
-            (Self::Mpu9250(b), EmulatedChip::Mpu6xxx(c)) => Ok(vec![mpu9250::reading(&b.read(c)?)]),
+            (Self::Mpu9250(b), EmulatedChip::Mpu6xxx(c)) => b.read(c),
             (Self::Icm42688p(b), EmulatedChip::Icm42688p(c)) => b.read(c),
             _ => Err(not_mine(self, chip)),
         }
     }
 
-    /// FIFO overflows so far (each one flushed the FIFO); 0 on chips read without a FIFO.
+    /// FIFO overflows so far (each one flushed the FIFO).
     pub fn overflows(&self) -> u64 {
         match self {
-            Self::Mpu9250(_) => 0,
+            Self::Mpu9250(b) => b.overflows(),
             Self::Icm42688p(b) => b.overflows(),
         }
     }

@@ -116,9 +116,23 @@ pub fn mag_axes_from_mpu<T: Copy + core::ops::Neg<Output = T>>(b: [T; 3]) -> [T;
 }
 
 /// The field in the MPU-9250 accel/gyro axes from the field in the AK8963's own axes: the
-/// inverse of [`mag_axes_from_mpu`] (the swap and the sign flip undo themselves).
+/// inverse of [`mag_axes_from_mpu`] (`x_mpu = y_ak`, `y_mpu = x_ak`, `z_mpu = −z_ak`).
+///
+/// ```
+/// use margemu_protocol::regmap::mpu6xxx::convert::{mag_axes_from_mpu, mag_axes_to_mpu};
+/// let b = [3.0f32, -5.0, 7.0];
+/// assert_eq!(mag_axes_to_mpu(mag_axes_from_mpu(b)), b);
+/// ```
 pub fn mag_axes_to_mpu<T: Copy + core::ops::Neg<Output = T>>(b: [T; 3]) -> [T; 3] {
+    // The swap and the sign flip undo themselves.
     mag_axes_from_mpu(b)
+}
+
+/// A field component in µT along its AK8963 axis from the register value `raw` (HX, HY or HZ),
+/// with the sensitivity adjustment of `asa` applied: the inverse of [`mag_to_raw`] to within
+/// one LSB.
+pub fn mag_from_raw(raw: i16, asa: u8, bits: MagBits) -> f64 {
+    f64::from(raw) * f64::from(bits.ut_per_lsb()) * f64::from(asa_factor(asa))
 }
 
 /// A measurement as the AK8963 stores it: the three data register values (AK8963 axes) and

@@ -31,7 +31,7 @@
 use core::ops::Range;
 
 use super::convert::{
-    accel_to_raw_with_offset, asa_factor, gyro_to_raw_with_offset, mag_axes_to_mpu,
+    accel_to_raw_with_offset, gyro_to_raw_with_offset, mag_axes_to_mpu, mag_from_raw,
     mag_measurement, STANDARD_GRAVITY,
 };
 use super::variant::TempScale;
@@ -234,11 +234,6 @@ impl ImageRepr {
         let lsb_per_radps = f64::from(cfg.gyro_fs.lsb_per_dps()) * 180.0 / core::f64::consts::PI;
         let gyro_offset_lsb =
             |i: usize| f64::from(cfg.gyro_offset[i]) * 4.0 / f64::from(1u8 << cfg.gyro_fs.bits());
-        let ut = |i: usize| {
-            f64::from(self.mag[i])
-                * f64::from(cfg.mag_bits.ut_per_lsb())
-                * f64::from(asa_factor(cfg.asa[i]))
-        };
         Physical {
             acc: core::array::from_fn(|i| {
                 let offset = f64::from(cfg.accel_offset[i] & !1) * lsb_per_g / 2048.0;
@@ -248,8 +243,26 @@ impl ImageRepr {
                 (f64::from(self.gyro[i]) - gyro_offset_lsb(i)) / lsb_per_radps
             }),
             temp_c: cfg.temp.from_raw(self.temp),
-            mag_ut: mag_axes_to_mpu([ut(0), ut(1), ut(2)]),
+            mag_ut: mag_axes_to_mpu(self.mag_ut_sensor_axes(cfg)),
         }
+    }
+
+    /// The magnetic field of these register values in µT in the AK8963's own axes, its
+    /// sensitivity adjustment (ASA of `cfg`) applied: what a driver reads before it turns the
+    /// field into the accel/gyro axes ([`to_physical`](Self::to_physical) does that turn).
+    pub fn mag_ut_sensor_axes(&self, cfg: &ImageConfig) -> [f64; 3] {
+        core::array::from_fn(|i| mag_from_raw(self.mag[i], cfg.asa[i], cfg.mag_bits))
+    }
+
+    /// Decodes one FIFO record of the MARG layout ([`fifo`](super::fifo)): the sensor bytes,
+    /// then slave 0's seven AK8963 bytes HXL..=HZH, ST2 (ST1 is not in the record; it reads
+    /// as DRDY, as in an image). Every byte pattern is valid.
+    pub fn parse_marg_record(record: &[u8; super::fifo::MARG_RECORD_LEN]) -> Self {
+        let mut image = [0u8; IMAGE_LEN];
+        image[field::SENSORS].copy_from_slice(&record[field::SENSORS]);
+        image[field::ST1] = ak8963::bits::ST1_DRDY;
+        image[field::MAG.start..=field::ST2].copy_from_slice(&record[field::SENSORS.end..]);
+        Self::parse(&image)
     }
 
     /// Decodes the first [`SENSORS_LEN`] bytes and, when present, the AK8963 block of an image

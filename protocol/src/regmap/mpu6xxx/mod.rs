@@ -18,6 +18,7 @@
 //! ```
 
 pub mod convert;
+pub mod fifo;
 pub mod image;
 pub mod rates;
 pub mod variant;
