@@ -1,15 +1,28 @@
 //! [`Plan`]: everything a streaming session keeps fixed once the device has answered Hello (the
 //! scene's counts and rates, the batch size and lead the device's capabilities allow, the
-//! timeouts), set once by the run and never changed; the run's mutable state lives in `Run`.
+//! windows of what the session keeps, the timeouts), set once by the run (`flow.rs`) and never
+//! changed; the run's mutable state lives in its parts (`pacing.rs`, `reports.rs`,
+//! `ending.rs`).
 //!
 //! Items are written in batches of up to `StreamConfig::batch`, capped by the frame, by the
 //! device's `max_batch` and by a quarter of its buffer. The lead is `StreamConfig::lead` capped
 //! at 3/8 of the device's buffer (so a due batch normally finds the credit it needs: the device
 //! grants its window a quarter of its buffer at a time).
+//!
+//! What the session keeps is bounded by the device's buffer: the write times of the last
+//! `buffer_capacity` items and a batch (a go-back starts no earlier than the credit window,
+//! `limit − buffer_capacity`, and nothing was written at or beyond `limit`); the items
+//! themselves, predicted up to [`PREDICT_AHEAD`] batches beyond the next to write (so a go-back
+//! always finds them); the Served check's window ([`served_window`], the items predicted ahead
+//! counted as buffered).
 
+use super::served::{served_window, MAX_WINDOW};
 use super::session::Session;
 use margemu_protocol::link::{HelloAck, Rate};
 use std::time::Duration;
+
+/// Batches predicted beyond the next one to write.
+const PREDICT_AHEAD: u64 = 2;
 
 /// The fixed parameters of a session (see the module docs). Times are ns.
 #[derive(Clone, Copy, Debug)]
@@ -34,8 +47,10 @@ pub(super) struct Plan {
     pub(super) capacity: u64,
     /// The last stretch before a due instant that is busy-waited.
     pub(super) spin_ns: u64,
+    /// The session number sent in Hello.
+    pub(super) session_id: u32,
     /// How long to wait for HelloAck and for the first credit window.
-    pub(super) hello_timeout_ns: u64,
+    pub(super) hello_timeout: Duration,
     /// How long a due batch may wait for credit.
     pub(super) credit_timeout: Duration,
     /// How long to wait for the last sample served and for the Stop confirmed.
@@ -60,7 +75,8 @@ impl Plan {
             lead_ns: 0,
             capacity: 0,
             spin_ns: ns(c.spin),
-            hello_timeout_ns: ns(c.hello_timeout),
+            session_id: c.session_id,
+            hello_timeout: c.hello_timeout,
             credit_timeout: c.credit_timeout,
             drain_ns: ns(c.drain_timeout),
             resend_after_ns: ns(c.resend_after),
@@ -98,6 +114,33 @@ impl Plan {
         (start + t).saturating_sub(self.lead_ns).max(start)
     }
 
+    /// Items predicted beyond the next one to write.
+    pub(super) fn ahead(&self) -> u64 {
+        PREDICT_AHEAD * self.batch
+    }
+
+    /// How many of the newest items' write times are kept (what a go-back can reach).
+    pub(super) fn write_times_kept(&self) -> usize {
+        let (batch, capacity) = (self.batch as usize, self.capacity as usize);
+        capacity.saturating_add(batch).min(MAX_WINDOW)
+    }
+
+    /// How many of the newest items are kept: those a go-back can reach, those predicted ahead
+    /// and a batch.
+    pub(super) fn items_kept(&self) -> usize {
+        let batch = self.batch as usize;
+        self.write_times_kept() + PREDICT_AHEAD as usize * batch + batch
+    }
+
+    /// How many predictions the Served check keeps ([`served_window`]).
+    pub(super) fn served_window(&self) -> usize {
+        let buffered =
+            (self.capacity as usize).saturating_add(PREDICT_AHEAD as usize * self.batch as usize);
+        let buffered = u32::try_from(buffered).unwrap_or(u32::MAX);
+        let hold = u32::try_from(self.hold).unwrap_or(u32::MAX);
+        served_window(buffered, hold)
+    }
+
     /// Host time at which Stop is due, for a Start written at host time `start`: half an output
     /// period after the last sample's instant (`None` for an empty scene).
     pub(super) fn stop_at(&self, start: u64) -> Option<u64> {
@@ -126,7 +169,8 @@ mod tests {
             lead_ns: 96_000_000,
             capacity: 256,
             spin_ns: 0,
-            hello_timeout_ns: 0,
+            session_id: 0,
+            hello_timeout: Duration::ZERO,
             credit_timeout: Duration::ZERO,
             drain_ns: 0,
             resend_after_ns: 0,

@@ -17,7 +17,7 @@ use margemu_sim::scene::chip::ChipSetup;
 use margemu_sim::scene::Scene;
 use std::io::{Read, Write};
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -191,6 +191,26 @@ impl Session {
         &self.settings
     }
 
+    /// The session's log writer.
+    pub(super) fn logger(&self) -> &Logger {
+        &self.log
+    }
+
+    /// The session's log writer, to queue rows.
+    pub(super) fn logger_mut(&mut self) -> &mut Logger {
+        &mut self.log
+    }
+
+    /// Ends the session but for its logs: the log writer, to close them.
+    pub(super) fn into_logger(self) -> Logger {
+        self.log
+    }
+
+    /// Whether the stop flag ([`Session::stop_flag`]) is set.
+    pub(super) fn stop_requested(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+
     /// Runs the session on a serial port (a clone of it feeds the receive thread).
     pub fn run_on_port(
         self,
@@ -227,15 +247,15 @@ impl Session {
     /// from the port's clock (e.g. a [`VirtualPort`](super::virtual_port::VirtualPort) on a
     /// virtual clock). The port is dropped before the logs are closed.
     pub fn run_with(
-        mut self,
+        self,
         port: impl Port,
         progress: impl FnMut(&Progress),
     ) -> Result<Summary, StreamError> {
-        let mut run = Run::new(&mut self, port, progress);
+        let mut run = Run::new(self, port, progress);
         let result = run.session_flow();
         let end_ns = run.now() as i64;
         let summary = run.summary();
-        drop(run);
+        let mut log = run.into_logger(); // the port is dropped here
         let (status, ended) = match &result {
             Ok(()) => (Status::Complete, "completed".to_string()),
             Err(e @ StreamError::Interrupted) => (Status::Interrupted, e.to_string()),
@@ -252,15 +272,11 @@ impl Session {
             samples_expected: Some(served.samples),
             ended,
         };
-        let logged = self
-            .log
+        let logged = log
             .write(move |log| log.event(end_ns, "end", &detail))
-            .and_then(|()| self.log.end(completion));
+            .and_then(|()| log.end(completion));
         result?;
-        logged.map_err(|source| StreamError::Log {
-            path: self.log.dir().to_path_buf(),
-            source,
-        })?;
+        logged.map_err(|source| log.error(source))?;
         Ok(summary)
     }
 }

@@ -11,7 +11,7 @@
 //! The items come from the session's [`Prediction`], read in order just before they are
 //! written ([`Session::predict_through`]): each output sample read passes its image's CRC-32C to
 //! the Served check and its truth to `truth.csv`. Only a [`Window`] of the newest items is kept
-//! (the device's buffer capacity and two batches, set by the pacing plan): what a go-back can
+//! (the device's buffer capacity and four batches, `Plan::items_kept`): what a go-back can
 //! still write again.
 
 use super::images::PredictedSample;
@@ -22,11 +22,10 @@ use super::window::Window;
 use super::{ModelSample, StreamError};
 use margemu_model::sensor;
 use margemu_protocol::link::{
-    max_images_per_batch, Configure, Encoder, Image, ImageBatch, KinematicsBatch, Message,
-    ModelParams, Modes, Rate, Source, CRC32C, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
+    max_images_per_batch, Capabilities, Configure, Encoder, Image, ImageBatch, KinematicsBatch,
+    Message, ModelParams, Modes, Rate, Source, CRC32C, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
 };
 use margemu_sim::run::RunError;
-use std::io;
 use std::iter::Peekable;
 
 /// The items a session streams.
@@ -59,7 +58,7 @@ type Stream = Box<dyn Iterator<Item = Result<(PredictedSample, Option<Item>), Ru
 pub(super) struct Prediction {
     stream: Peekable<Stream>,
     /// The newest items predicted.
-    pub(super) items: Window<Item>,
+    items: Window<Item>,
     /// Output samples predicted so far.
     outputs: u64,
 }
@@ -83,6 +82,12 @@ impl Prediction {
             items: Window::new(1),
             outputs: 0,
         }
+    }
+
+    /// Keeps the newest `span` items from now on (set once the plan is known, before any is
+    /// predicted).
+    fn keep(&mut self, span: usize) {
+        self.items = Window::new(span);
     }
 
     /// Waits for the first sample: an error the prediction fails with at once (a reference that
@@ -128,6 +133,11 @@ impl Session {
         }
     }
 
+    /// Keeps the newest `span` items predicted (`Plan::items_kept`).
+    pub(super) fn keep_items(&mut self, span: usize) {
+        self.prediction.keep(span);
+    }
+
     /// Reads the prediction until items `.. end` and every output sample they cover are
     /// predicted: their CRCs go to `served`, their truth to `truth.csv`.
     pub(super) fn predict_through(
@@ -156,15 +166,11 @@ impl Session {
         if truths.is_empty() {
             return Ok(());
         }
-        let written = self.log.write(move |log| log.truth(&truths));
-        written.map_err(|source| StreamError::Log {
-            path: self.log.dir().to_path_buf(),
-            source,
-        })
+        self.log.queue(move |log| log.truth(&truths))
     }
 
     /// The kept items `first .. first + n` (a go-back never reaches further back than the
-    /// window, see `Run::plan_pacing`).
+    /// window, see `Plan::items_kept`).
     fn items(&self, first: u64, n: u64) -> impl Iterator<Item = Item> + '_ {
         (first..first + n).map(|j| {
             *self
@@ -200,7 +206,7 @@ impl Session {
     }
 
     /// The source the device must support.
-    pub(super) fn required_mode(&self) -> (Modes, &'static str) {
+    fn required_mode(&self) -> (Modes, &'static str) {
         match &self.items {
             Items::Images => (Modes::IMAGES, "it does not take register images"),
             Items::Kinematics { .. } => (
@@ -210,8 +216,25 @@ impl Session {
         }
     }
 
-    /// Configure for this session's chip, rate and source.
-    pub(super) fn configure_message(&self, telemetry_period_ns: u64) -> Configure {
+    /// Why a device with capabilities `caps` cannot serve this session (`None`: it can): it
+    /// must emulate the chip, support the source mode, and have batch and buffer space.
+    pub(super) fn refusal(&self, caps: &Capabilities) -> Option<String> {
+        let (mode, no_mode) = self.required_mode();
+        let model = self.chip.model;
+        if !caps.chips.has(model) {
+            Some(format!("it does not emulate the {}", model.part_name()))
+        } else if !caps.modes.contains(mode) {
+            Some(no_mode.to_owned())
+        } else if caps.max_batch == 0 || caps.buffer_capacity == 0 {
+            Some("it announces no batch or buffer space".to_owned())
+        } else {
+            None
+        }
+    }
+
+    /// Configure for this session's chip, rate, source and Telemetry period.
+    pub(super) fn configure_message(&self) -> Configure {
+        let telemetry_period_ns = self.config.telemetry_period.as_nanos() as u64;
         let source = match &self.items {
             Items::Images => Source::Images,
             Items::Kinematics { params, .. } => Source::Model(**params),
@@ -253,13 +276,13 @@ impl Session {
         send_ns: i64,
         late_ns: Option<i64>,
         resend: bool,
-    ) -> io::Result<()> {
+    ) -> Result<(), StreamError> {
         let rate = self.item_rate();
         let rows = first..first + n;
         match &self.items {
             Items::Images => {
                 let images: Vec<Image> = self.items(first, n).filter_map(image_of).collect();
-                self.log.write(move |log| {
+                self.log.queue(move |log| {
                     rows.zip(&images).try_for_each(|(j, image)| {
                         let t_ns = rate.sample_time_ns(j);
                         log.sent_image(j, t_ns, send_ns, late_ns, image, resend)
@@ -268,7 +291,7 @@ impl Session {
             }
             Items::Kinematics { .. } => {
                 let kinematics: Vec<_> = self.items(first, n).filter_map(kinematics_of).collect();
-                self.log.write(move |log| {
+                self.log.queue(move |log| {
                     rows.zip(&kinematics).try_for_each(|(j, k)| {
                         let t_ns = rate.sample_time_ns(j);
                         log.sent_kinematics(j, t_ns, send_ns, late_ns, k, resend)
