@@ -39,7 +39,9 @@ impl Ending {
     /// The sample the device must report serving before Stop is written: the last one when it
     /// stops at once (source model).
     pub(super) fn awaited(plan: &Plan) -> Option<u64> {
-        plan.samples.checked_sub(1).filter(|_| plan.stops_at_once)
+        plan.samples()
+            .checked_sub(1)
+            .filter(|_| plan.stops_at_once())
     }
 
     /// Stop is about to be written.

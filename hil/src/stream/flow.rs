@@ -164,7 +164,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
                 let log = self.session.logger_mut();
                 let telemetry = self
                     .reports
-                    .message(log, self.plan.rate, at_ns, seq, message)?;
+                    .message(log, self.plan.rate(), at_ns, seq, message)?;
                 let lost = match telemetry {
                     Some(t) if !self.ending.stopping() => self.pacing.check_lost(&self.plan, &t),
                     _ => None,
@@ -180,10 +180,10 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
     fn handshake(&mut self) -> Result<(), StreamError> {
         let hello = Hello {
             protocol_version: PROTOCOL_VERSION,
-            session: self.plan.session_id,
+            session: self.plan.session_id(),
         };
         self.send(&Message::Hello(hello))?;
-        let timeout = self.plan.hello_timeout;
+        let timeout = self.plan.hello_timeout();
         let deadline = self.now() + timeout.as_nanos() as u64;
         while self.reports.ack().is_none() {
             if self.now() >= deadline {
@@ -212,7 +212,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
         let cfg = self.session.configure_message();
         self.reports.expect_credit();
         self.send(&Message::Configure(cfg))?;
-        let timeout = self.plan.hello_timeout;
+        let timeout = self.plan.hello_timeout();
         let deadline = self.now() + timeout.as_nanos() as u64;
         while !self.reports.credit_seen() {
             if self.now() >= deadline {
@@ -227,8 +227,8 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
         let detail = format!(
             "credit limit {}; batch {}; lead {} us",
             self.reports.credit_limit(),
-            self.plan.batch,
-            self.plan.lead_ns / 1000
+            self.plan.batch(),
+            self.plan.lead().as_micros()
         );
         self.event("configured", &detail)
     }
@@ -239,7 +239,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
             self.write_batch(n, None, false)?;
         }
         // The device serves samples 0..total and stops by itself at the scene's end.
-        self.send(&Message::Start(Start::scene(0, self.plan.samples)))?;
+        self.send(&Message::Start(Start::scene(0, self.plan.samples())))?;
         let start = self.now();
         self.pacing.started(start);
         let detail = format!(
@@ -267,7 +267,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
         // Predicted ahead while there is time, so a due batch never waits for its prediction.
         self.predict_through(self.pacing.predict_to(&self.plan))?;
         let due = self.pacing.due(&self.plan).expect("started");
-        let spin = self.plan.spin_ns;
+        let spin = self.plan.spin_ns();
         if self.now() + spin < due {
             return self.pump(due - spin);
         }
@@ -311,9 +311,9 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
     /// the last sample reported served first), waits for the device to confirm it and logs
     /// the outcome.
     fn finish(&mut self) -> Result<(), StreamError> {
-        let drain = self.plan.drain_ns;
+        let drain = self.plan.drain_ns();
         if let Some(stop_at) = Ending::stop_at(&self.plan, self.pacing.start()) {
-            let spin = self.plan.spin_ns;
+            let spin = self.plan.spin_ns();
             while self.now() + spin < stop_at {
                 if self.pacing.has_next(&self.plan) {
                     self.send_next()?; // a go-back
@@ -351,7 +351,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
             let _ = self.event(event, &detail);
             return;
         }
-        let deadline = self.now() + self.plan.drain_ns;
+        let deadline = self.now() + self.plan.drain_ns();
         while !self.reports.device_stopped() && self.now() < deadline {
             if let Some(event) = self.port.wait(deadline) {
                 if self.handle(event).is_err() {
@@ -377,7 +377,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
     fn progress_now(&self) -> Progress {
         Progress {
             sent: self.pacing.sent(),
-            total: self.plan.stream_len,
+            total: self.plan.stream_len(),
             resends: self.pacing.rewinds(),
             elapsed: self.elapsed(),
             telemetry: self.reports.telemetry(),
@@ -391,7 +391,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
     /// How the run went, so far.
     pub(super) fn summary(&self) -> Summary {
         Summary {
-            samples: self.plan.samples,
+            samples: self.plan.samples(),
             sent: self.pacing.sent(),
             resends: self.pacing.rewinds(),
             resent: self.pacing.resent(),
@@ -404,10 +404,10 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
             host_rx: self.reports.host_rx(),
             credit_stalls: self.pacing.credit_stalls(),
             served: self.reports.served(),
-            stream_len: self.plan.stream_len,
+            stream_len: self.plan.stream_len(),
             source: self.session.source(),
-            batch: self.plan.batch,
-            lead: Duration::from_nanos(self.plan.lead_ns),
+            batch: self.plan.batch(),
+            lead: self.plan.lead(),
             link: self.pacing.link(),
             image_settings: *self.session.image_settings(),
             elapsed: self.elapsed(),

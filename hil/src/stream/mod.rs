@@ -36,9 +36,9 @@
 //! device's reports (`reports.rs`: HelloAck, credit window, Telemetry, the receiver's counts,
 //! the Served check); the pacing (`pacing.rs`: the next item, the go-back-N write times, the
 //! figures of the writes: lateness, credit stalls, bytes); the ending (`ending.rs`: when Stop
-//! is due, whether it was written, how it went). The reports, the pacing and the ending keep
-//! their fields private and answer through their methods; the run alone sequences them and is
-//! the only one that waits, writes and handles device events.
+//! is due, whether it was written, how it went). The plan, the reports, the pacing and the
+//! ending keep their fields private and answer through their methods; the run alone sequences
+//! them and is the only one that waits, writes and handles device events.
 //!
 //! **Time is injected.** The streaming core (the run: pacing, credit, resend, Served checks,
 //! Stop) never reads the operating system's clock: it reads and waits for time only through its

@@ -83,7 +83,7 @@ impl Pacing {
 
     /// Whether items remain to be written (a go-back included).
     pub(super) fn has_next(&self, plan: &Plan) -> bool {
-        self.next < plan.stream_len
+        self.next < plan.stream_len()
     }
 
     /// Whether the next item was written before (a go-back).
@@ -94,15 +94,15 @@ impl Pacing {
     /// The items to predict before the next batch is due: up to [`Plan::ahead`] beyond the
     /// next to write.
     pub(super) fn predict_to(&self, plan: &Plan) -> u64 {
-        (self.next + plan.ahead()).min(plan.stream_len)
+        (self.next + plan.ahead()).min(plan.stream_len())
     }
 
     /// The next prefill batch's size while `available` items of credit remain (`None`: the
     /// prefill is done): the items due at Start, within the credit window.
     pub(super) fn prefill(&self, plan: &Plan, available: u64) -> Option<u64> {
-        let total = plan.stream_len;
-        let due = self.next < total && plan.item_rate.sample_time_ns(self.next) <= plan.lead_ns;
-        (due && available > 0).then(|| plan.batch.min(available).min(total - self.next))
+        let total = plan.stream_len();
+        let due = self.next < total && plan.due_at_start(self.next);
+        (due && available > 0).then(|| plan.batch().min(available).min(total - self.next))
     }
 
     /// Start was written at host time `at`.
@@ -122,7 +122,7 @@ impl Pacing {
 
     /// The items the next batch would carry with all the credit it needs.
     pub(super) fn wanted(&self, plan: &Plan) -> u64 {
-        plan.batch.min(plan.stream_len - self.next)
+        plan.batch().min(plan.stream_len() - self.next)
     }
 
     /// What to do at host time `now`, once the next batch's instant has come, with `available`
@@ -139,7 +139,7 @@ impl Pacing {
                 self.credit_stalls += 1;
                 now
             });
-            let timeout = plan.credit_timeout;
+            let timeout = plan.credit_timeout();
             let limit = since + timeout.as_nanos() as u64;
             if now >= limit {
                 return Err(StreamError::CreditTimeout {
@@ -152,7 +152,10 @@ impl Pacing {
         // A batch held back by the credit window is late because of the device, not of the
         // pacing: logged, but left out of the jitter figures.
         let paced = self.stall.take().is_none();
-        let mut n = plan.batch.min(available).min(plan.stream_len - self.next);
+        let mut n = plan
+            .batch()
+            .min(available)
+            .min(plan.stream_len() - self.next);
         if self.resending() {
             n = n.min(self.go_back.high() - self.next);
         }
@@ -210,15 +213,15 @@ impl Pacing {
     ) -> Option<(&'static str, String)> {
         let contiguous = t
             .next_index
-            .saturating_sub(t.credit_limit.saturating_sub(plan.capacity));
-        let all_written = self.go_back.high() == plan.stream_len;
+            .saturating_sub(t.credit_limit.saturating_sub(plan.capacity()));
+        let all_written = self.go_back.high() == plan.stream_len();
         let beyond = u64::from(t.buffer_level) > contiguous || all_written;
         let running = t.state == DeviceState::Running;
         let (Some(start), true, true) = (self.start, running, beyond) else {
             return None;
         };
         let (next_index, tau) = (t.next_index, t.time_ns);
-        let margin = plan.resend_after_ns as i64;
+        let margin = plan.resend_after_ns() as i64;
         let seen_by = start as i64 + tau as i64 - margin;
         match self.go_back.lost(next_index, seen_by) {
             Some(hole) if hole < self.next => {

@@ -28,35 +28,35 @@ const PREDICT_AHEAD: u64 = 2;
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Plan {
     /// Output samples in the scene.
-    pub(super) samples: u64,
+    samples: u64,
     /// Items to stream (output samples, or kinematics samples in source model).
-    pub(super) stream_len: u64,
+    stream_len: u64,
     /// The scene's output rate.
-    pub(super) rate: Rate,
+    rate: Rate,
     /// The rate of the items.
-    pub(super) item_rate: Rate,
+    item_rate: Rate,
     /// Output samples per item.
-    pub(super) hold: u64,
+    hold: u64,
     /// The device stops at once on Stop (source model) rather than serving what it holds.
-    pub(super) stops_at_once: bool,
+    stops_at_once: bool,
     /// Items per batch.
-    pub(super) batch: u64,
+    batch: u64,
     /// How far ahead of its first item's instant a batch is due.
-    pub(super) lead_ns: u64,
+    lead_ns: u64,
     /// The device's buffer, items (0 before the handshake).
-    pub(super) capacity: u64,
+    capacity: u64,
     /// The last stretch before a due instant that is busy-waited.
-    pub(super) spin_ns: u64,
+    spin_ns: u64,
     /// The session number sent in Hello.
-    pub(super) session_id: u32,
+    session_id: u32,
     /// How long to wait for HelloAck and for the first credit window.
-    pub(super) hello_timeout: Duration,
+    hello_timeout: Duration,
     /// How long a due batch may wait for credit.
-    pub(super) credit_timeout: Duration,
+    credit_timeout: Duration,
     /// How long to wait for the last sample served and for the Stop confirmed.
-    pub(super) drain_ns: u64,
+    drain_ns: u64,
     /// How long after its last write an item the device reports lost may be written again.
-    pub(super) resend_after_ns: u64,
+    resend_after_ns: u64,
 }
 
 impl Plan {
@@ -112,6 +112,76 @@ impl Plan {
     pub(super) fn due(&self, start: u64, j: u64) -> u64 {
         let t = self.item_rate.sample_time_ns(j);
         (start + t).saturating_sub(self.lead_ns).max(start)
+    }
+
+    /// Output samples in the scene.
+    pub(super) fn samples(&self) -> u64 {
+        self.samples
+    }
+
+    /// Items to stream (output samples, or kinematics samples in source model).
+    pub(super) fn stream_len(&self) -> u64 {
+        self.stream_len
+    }
+
+    /// The scene's output rate.
+    pub(super) fn rate(&self) -> Rate {
+        self.rate
+    }
+
+    /// Whether item `j` is due at Start: its instant is within the lead.
+    pub(super) fn due_at_start(&self, j: u64) -> bool {
+        self.item_rate.sample_time_ns(j) <= self.lead_ns
+    }
+
+    /// Whether the device stops at once on Stop (source model).
+    pub(super) fn stops_at_once(&self) -> bool {
+        self.stops_at_once
+    }
+
+    /// Items per batch.
+    pub(super) fn batch(&self) -> u64 {
+        self.batch
+    }
+
+    /// How far ahead of its first item's instant a batch is due.
+    pub(super) fn lead(&self) -> Duration {
+        Duration::from_nanos(self.lead_ns)
+    }
+
+    /// The device's buffer, items (0 before the handshake).
+    pub(super) fn capacity(&self) -> u64 {
+        self.capacity
+    }
+
+    /// The last stretch before a due instant that is busy-waited, ns.
+    pub(super) fn spin_ns(&self) -> u64 {
+        self.spin_ns
+    }
+
+    /// The session number sent in Hello.
+    pub(super) fn session_id(&self) -> u32 {
+        self.session_id
+    }
+
+    /// How long to wait for HelloAck and for the first credit window.
+    pub(super) fn hello_timeout(&self) -> Duration {
+        self.hello_timeout
+    }
+
+    /// How long a due batch may wait for credit.
+    pub(super) fn credit_timeout(&self) -> Duration {
+        self.credit_timeout
+    }
+
+    /// How long to wait for the last sample served and for the Stop confirmed, ns.
+    pub(super) fn drain_ns(&self) -> u64 {
+        self.drain_ns
+    }
+
+    /// How long after its last write an item the device reports lost may be written again, ns.
+    pub(super) fn resend_after_ns(&self) -> u64 {
+        self.resend_after_ns
     }
 
     /// Items predicted beyond the next one to write.

@@ -34,20 +34,20 @@ impl Reports {
     /// Nothing heard yet, for a session planned as `plan` before the handshake.
     pub(super) fn new(plan: &Plan) -> Self {
         Self {
-            session_id: plan.session_id,
+            session_id: plan.session_id(),
             ack: None,
             credit: Credit::default(),
             credit_seen: false,
             telemetry: None,
             host_rx: RxStats::default(),
-            served: ServedCheck::new(plan.samples, 1),
+            served: ServedCheck::new(plan.samples(), 1),
         }
     }
 
     /// Sizes the Served check for the plan set from the HelloAck (before anything is
     /// predicted).
     pub(super) fn plan(&mut self, plan: &Plan) {
-        self.served = ServedCheck::new(plan.samples, plan.served_window());
+        self.served = ServedCheck::new(plan.samples(), plan.served_window());
     }
 
     /// The device's HelloAck to our Hello.
