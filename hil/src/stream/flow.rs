@@ -53,7 +53,7 @@ fn host_ns(at: u64) -> i64 {
 impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
     /// `session` about to open with Hello on `port`.
     pub(super) fn new(session: Session, port: L, progress: P) -> Self {
-        let plan = Plan::before_handshake(&session);
+        let plan = session.plan_before_handshake();
         let last_progress = port.now_ns();
         Self {
             reports: Reports::new(&plan),
@@ -220,7 +220,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
             }
             self.pump(deadline)?;
         }
-        self.plan = Plan::new(&self.session, self.reports.ack().as_ref());
+        self.plan = self.session.plan(self.reports.ack().as_ref());
         self.reports.plan(&self.plan);
         self.pacing.plan(&self.plan);
         self.session.keep_items(self.plan.items_kept());

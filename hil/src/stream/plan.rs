@@ -17,7 +17,8 @@
 //! counted as buffered).
 
 use super::served::{served_window, MAX_WINDOW};
-use super::session::Session;
+use super::session::StreamConfig;
+use super::source::Source;
 use margemu_protocol::link::{HelloAck, Rate};
 use std::time::Duration;
 
@@ -61,16 +62,15 @@ pub(super) struct Plan {
 
 impl Plan {
     /// The plan before the device has answered: one item per batch, no lead, no buffer.
-    pub(super) fn before_handshake(session: &Session) -> Self {
-        let c = &session.config;
+    pub(super) fn before_handshake(source: &Source, c: &StreamConfig) -> Self {
         let ns = |d: Duration| d.as_nanos() as u64;
         Self {
-            samples: session.samples,
-            stream_len: session.stream_len(),
-            rate: session.rate,
-            item_rate: session.item_rate(),
-            hold: session.hold(),
-            stops_at_once: session.stops_at_once(),
+            samples: source.samples(),
+            stream_len: source.stream_len(),
+            rate: source.rate(),
+            item_rate: source.item_rate(),
+            hold: source.hold(),
+            stops_at_once: source.stops_at_once(),
             batch: 1,
             lead_ns: 0,
             capacity: 0,
@@ -85,25 +85,24 @@ impl Plan {
 
     /// The plan for a device that answered `ack` (a device without one is planned as one of
     /// batch 1 and buffer 4).
-    pub(super) fn new(session: &Session, ack: Option<&HelloAck>) -> Self {
+    pub(super) fn new(source: &Source, config: &StreamConfig, ack: Option<&HelloAck>) -> Self {
         let (max_batch, capacity) = ack.map_or((1, 4), |a| {
             let c = a.capabilities;
             (usize::from(c.max_batch), c.buffer_capacity as usize)
         });
-        let batch = session
-            .config
+        let batch = config
             .batch
             .min(max_batch)
-            .min(session.max_per_frame())
+            .min(source.max_per_frame())
             .min(capacity / 4)
             .max(1);
-        let window = session.item_rate().sample_time_ns(3 * capacity as u64 / 8);
-        let lead = session.config.lead.min(Duration::from_nanos(window));
+        let window = source.item_rate().sample_time_ns(3 * capacity as u64 / 8);
+        let lead = config.lead.min(Duration::from_nanos(window));
         Self {
             batch: batch as u64,
             lead_ns: lead.as_nanos() as u64,
             capacity: capacity as u64,
-            ..Self::before_handshake(session)
+            ..Self::before_handshake(source, config)
         }
     }
 
