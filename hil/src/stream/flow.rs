@@ -1,4 +1,4 @@
-//! The running session ([`Run`]): it owns the [`Session`] (its prediction and log writer), its
+//! The running session ([`Run`]): it owns the [`Session`] (its items and log writer), its
 //! [`Port`] (which also tells the time), the fixed [`Plan`] and the run's parts, each with its
 //! own state behind its own methods: [`Reports`] (what the device has said, `reports.rs`),
 //! [`Pacing`] (what to write when, and the figures of the writes, `pacing.rs`) and [`Ending`]
