@@ -290,3 +290,67 @@ impl Pacing {
         self.link
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use margemu_protocol::link::Rate;
+
+    fn plan() -> Plan {
+        Plan::example(1000, Rate::new(1000, 1).unwrap()) // batches of 32, 96 ms lead
+    }
+
+    #[test]
+    fn the_prefill_takes_the_items_due_at_start_within_the_credit() {
+        let (plan, mut p) = (plan(), Pacing::new());
+        assert_eq!(p.prefill(&plan, 0), None, "no credit");
+        assert_eq!(p.prefill(&plan, 20), Some(20));
+        for _ in 0..3 {
+            assert_eq!(p.prefill(&plan, 1000), Some(32));
+            p.written(32, None, false, 0, 0);
+        }
+        assert_eq!(
+            p.prefill(&plan, 1000),
+            Some(32),
+            "item 96 is due at 96 ms: the lead"
+        );
+        p.written(32, None, false, 0, 0);
+        assert_eq!(p.prefill(&plan, 1000), None, "item 128 is not");
+        assert_eq!(p.jitter().batches, 0, "the prefill is not paced");
+    }
+
+    #[test]
+    fn a_batch_without_credit_stalls_until_the_credit_timeout() {
+        let (plan, mut p) = (plan(), Pacing::new());
+        p.started(5);
+        assert_eq!(p.due(&plan), Some(5));
+        let timeout = 2_000_000_000;
+        assert_eq!(p.step(&plan, 0, 10).unwrap(), Step::Stalled(10 + timeout));
+        assert_eq!(p.step(&plan, 0, 20).unwrap(), Step::Stalled(10 + timeout));
+        assert_eq!(p.credit_stalls(), 1, "one stall, however long");
+        let held = p.step(&plan, 8, 30).unwrap();
+        assert_eq!(held, Step::Write { n: 8, paced: false });
+        assert_eq!(
+            p.step(&plan, 100, 40).unwrap(),
+            Step::Write { n: 32, paced: true }
+        );
+        p.step(&plan, 0, 50).unwrap();
+        let err = p.step(&plan, 0, 50 + timeout).unwrap_err();
+        assert!(
+            matches!(err, StreamError::CreditTimeout { index: 0, .. }),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn paced_batches_keep_how_late_they_were_written() {
+        let (plan, mut p) = (plan(), Pacing::new());
+        p.started(0);
+        assert_eq!(p.written(32, Some(100), true, 150, 400), Some(300));
+        assert_eq!(p.written(32, Some(200), false, 900, 1000), Some(800));
+        let j = p.jitter();
+        assert_eq!((j.batches, j.max_ns, p.max_late_ns()), (1, 50, 50));
+        assert_eq!(p.written_jitter().max_ns, 300);
+        assert_eq!((p.next(), p.sent(), p.has_next(&plan)), (64, 64, true));
+    }
+}

@@ -223,11 +223,11 @@ impl Plan {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn plan(samples: u64, rate: Rate) -> Plan {
-        Plan {
+impl Plan {
+    /// A plan for unit tests: `samples` images at `rate`, batches of 32, a 96 ms lead, a
+    /// buffer of 256, a credit timeout of 2 s, no spin and no resend margin.
+    pub(super) fn example(samples: u64, rate: Rate) -> Self {
+        Self {
             samples,
             stream_len: samples,
             rate,
@@ -240,10 +240,19 @@ mod tests {
             spin_ns: 0,
             session_id: 0,
             hello_timeout: Duration::ZERO,
-            credit_timeout: Duration::ZERO,
+            credit_timeout: Duration::from_secs(2),
             drain_ns: 0,
             resend_after_ns: 0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(samples: u64, rate: Rate) -> Plan {
+        Plan::example(samples, rate)
     }
 
     #[test]
