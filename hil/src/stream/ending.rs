@@ -1,54 +1,79 @@
-//! How a session's device is stopped: after the last sample ([`Run::finish`](super::pacing)) or
-//! when the session is interrupted (SIGINT, SIGTERM, SIGHUP, the stop flag). Either way Stop is
-//! sent, the host waits up to the drain timeout for Telemetry in the stopped state, and
-//! `events.csv` says whether the device confirmed it (`stopped`) or not (`stop_unconfirmed`).
+//! [`Ending`]: how a session's device is stopped, after the last sample or when the session is
+//! interrupted (SIGINT, SIGTERM, SIGHUP, the stop flag). The run (`flow.rs`) sequences it with
+//! these answers.
+//!
+//! After the last sample, Stop is written half an output period after the last sample's instant,
+//! on the session's clock ([`Plan::stop_at`]); go-backs are still written until then. The device
+//! stops by itself at the scene's end (Start's `end_index`), so it never serves an instant after
+//! the last sample, however late Stop arrives; Stop confirms that. In source images a Stop that
+//! arrives early is graceful (the device serves what it still holds). In source model it stops
+//! at once, and the device's clock lags the host's by the Start's delivery time, so the host
+//! first waits, up to the drain timeout, until the device reports serving the last sample
+//! ([`Ending::awaited`]).
+//!
+//! After an interruption, Stop is written at once (the device then holds its last sample
+//! instead of counting underruns).
+//!
+//! Either way, once Stop is written the device's reports no longer lead to go-backs
+//! ([`Ending::stopping`]), the host waits up to the drain timeout for Telemetry in the stopped
+//! state, and `events.csv` says whether the device confirmed it (`stopped`) or not
+//! (`stop_unconfirmed`, [`Ending::outcome`]).
 
-use super::flow::Run;
-use super::port::Port;
-use super::{Progress, StreamError};
-use margemu_protocol::link::{DeviceState, Message};
+use super::plan::Plan;
+use super::reports::Reports;
+use margemu_protocol::link::DeviceState;
 
-impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
-    /// Whether the device's last Telemetry says it has stopped.
-    pub(super) fn device_stopped(&self) -> bool {
-        self.reports
-            .telemetry
-            .is_some_and(|t| t.state == DeviceState::Stopped)
+/// Whether a run has written Stop (see the module docs).
+#[derive(Default)]
+pub(super) struct Ending {
+    stop_written: bool,
+}
+
+impl Ending {
+    /// Host time at which Stop is due after the last sample, for a Start written at `start`
+    /// (`None`: never started, or an empty scene: Stop at once).
+    pub(super) fn stop_at(plan: &Plan, start: Option<u64>) -> Option<u64> {
+        start.and_then(|start| plan.stop_at(start))
     }
 
-    /// Logs whether the device confirmed Stop: `stopped` (with what it served) or
-    /// `stop_unconfirmed`.
-    pub(super) fn log_stop_outcome(&mut self) -> Result<(), StreamError> {
-        match self.reports.telemetry {
+    /// The sample the device must report serving before Stop is written: the last one when it
+    /// stops at once (source model).
+    pub(super) fn awaited(plan: &Plan) -> Option<u64> {
+        plan.samples()
+            .checked_sub(1)
+            .filter(|_| plan.stops_at_once())
+    }
+
+    /// Stop is about to be written.
+    pub(super) fn stop(&mut self) {
+        self.stop_written = true;
+    }
+
+    /// Whether Stop was written: the device's reports no longer lead to go-backs.
+    pub(super) fn stopping(&self) -> bool {
+        self.stop_written
+    }
+
+    /// The `events.csv` row that says whether the device confirmed Stop: `stopped` (with what
+    /// it served) or `stop_unconfirmed`.
+    pub(super) fn outcome(reports: &Reports) -> (&'static str, String) {
+        match reports.telemetry() {
             Some(t) if t.state == DeviceState::Stopped => {
                 let detail = format!(
                     "served {} samples, last index {}, underruns {}",
                     t.samples_served, t.last_served_index, t.underruns
                 );
-                self.event("stopped", &detail)
+                ("stopped", detail)
             }
-            _ => self.event("stop_unconfirmed", "no Telemetry in the stopped state"),
+            _ => (
+                "stop_unconfirmed",
+                "no Telemetry in the stopped state".into(),
+            ),
         }
     }
 
-    /// After an interruption: sends Stop (the device then holds its last sample instead of
-    /// counting underruns), waits up to the drain timeout for the device to confirm it (the
-    /// stop flag no longer counts), and logs the outcome. Errors are left to the session's
-    /// `end` row: this is the best that can be done on the way out.
-    pub(super) fn stop_after_interrupt(&mut self) {
-        self.stop_sent = true;
-        if self.send(&Message::Stop).is_err() {
-            let _ = self.event("stop_unconfirmed", "Stop could not be written");
-            return;
-        }
-        let deadline = self.now() + self.plan.drain_ns;
-        while !self.device_stopped() && self.now() < deadline {
-            if let Some(event) = self.port.wait(deadline) {
-                if self.handle(event).is_err() {
-                    break;
-                }
-            }
-        }
-        let _ = self.log_stop_outcome();
+    /// The `events.csv` row when Stop could not be written after an interruption.
+    pub(super) fn unwritten() -> (&'static str, String) {
+        ("stop_unconfirmed", "Stop could not be written".into())
     }
 }

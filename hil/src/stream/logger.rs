@@ -11,6 +11,7 @@
 //! ([`CompletionRecord`]): [`Logger::end`] sets it and lets go of it after the last row.
 
 use super::log::SessionLog;
+use super::StreamError;
 use margemu_sim::rundir::{Completion, CompletionRecord};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -90,6 +91,22 @@ impl Logger {
             _ => self
                 .finish()
                 .and(Err(io::Error::other("the log writer has ended"))),
+        }
+    }
+
+    /// Queues `job`, as [`Logger::write`]; a failure is the session's [`StreamError::Log`].
+    pub(super) fn queue(
+        &mut self,
+        job: impl FnOnce(&mut SessionLog) -> io::Result<()> + Send + 'static,
+    ) -> Result<(), StreamError> {
+        self.write(job).map_err(|source| self.error(source))
+    }
+
+    /// A failure to write the session's logs.
+    pub(super) fn error(&self, source: io::Error) -> StreamError {
+        StreamError::Log {
+            path: self.dir.clone(),
+            source,
         }
     }
 

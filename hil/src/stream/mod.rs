@@ -29,17 +29,28 @@
 //! 5. Stop after the last sample (in mode (b) once the device reports serving it), which
 //!    confirms the end, then wait for Telemetry in the stopped state.
 //!
+//! **One run, its parts each with their own state.** A [`Session`] owns its settings, what it
+//! streams (`source.rs`: the items and their lazy prediction) and its log writer (`logger.rs`).
+//! [`Session::run_with`] hands the session to a run (`flow.rs`), which owns it and the port,
+//! and composes: the plan (`plan.rs`), what is fixed once the device has answered (counts,
+//! rates, batch, lead, the windows of what is kept, timeouts), set once and never changed; the
+//! device's reports (`reports.rs`: HelloAck, credit window, Telemetry, the receiver's counts,
+//! the Served check); the pacing (`pacing.rs`: the next item, the go-back-N write times, the
+//! figures of the writes: lateness, credit stalls, bytes); the ending (`ending.rs`: when Stop
+//! is due, whether it was written, how it went). Every one of these keeps its fields private
+//! and answers through its methods; the run alone sequences them and is the only one that
+//! waits, writes and handles device events. When the run ends it drops the port and hands the
+//! log writer back to the session, which writes the `end` row and closes the logs.
+//!
 //! **Time is injected.** The streaming core (the run: pacing, credit, resend, Served checks,
 //! Stop) never reads the operating system's clock: it reads and waits for time only through its
-//! [`Port`], which writes its frames, hands over the device's and owns a [`clock::Clock`]. What
-//! is fixed for a session once the device has answered (counts, rates, batch, lead, timeouts)
-//! is one plan set once; the run owns its mutable state. [`Session::run`] uses a
-//! [`SystemPort`]: the real port, a receive thread ([`rx`]) that decodes the device's frames
-//! concurrently and counts damaged ones, and the host's monotonic clock
-//! ([`clock::SystemClock`]). [`Session::run_with`] takes any port: a [`VirtualPort`] runs the
-//! firmware's link handler on a [`clock::VirtualClock`], with injected faults (a lost batch,
-//! credit withheld, a late wake), so a session's every time is exact and independent of the
-//! machine's load (`host/tests/stream_core.rs`).
+//! [`Port`], which writes its frames, hands over the device's and owns a [`clock::Clock`].
+//! [`Session::run`] uses a [`SystemPort`]: the real port, a receive thread ([`rx`]) that
+//! decodes the device's frames concurrently and counts damaged ones, and the host's monotonic
+//! clock ([`clock::SystemClock`]). [`Session::run_with`] takes any port: a [`VirtualPort`]
+//! runs the firmware's link handler on a [`clock::VirtualClock`], with injected faults (a lost
+//! batch, credit withheld, a late wake), so a session's every time is exact and independent of
+//! the machine's load (`host/tests/stream_core.rs`).
 //!
 //! ```
 //! use margemu_hil::stream::clock::VirtualClock;

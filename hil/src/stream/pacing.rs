@@ -1,143 +1,145 @@
-//! Pacing: the prefill, the batches written in real time on the session's clock within the
-//! device's credit window, and the Stop after the last sample's instant.
+//! [`Pacing`]: which items to write and when, and what the run measured of its own writes.
 //!
 //! Items (images, or kinematics in source mode model) are written in batches of the plan's size
-//! ([`super::plan`]). The batch starting at item `j` is due at `start + t_j − lead`
-//! ([`Plan::due`](super::plan::Plan::due)). The run waits for it through its port, handling
-//! device messages meanwhile, and busy-waits the last `StreamConfig::spin` (200 µs) before it
-//! ([`Port::spin_until`]). Stop: see [`Run::finish`].
+//! ([`super::plan`]): first the prefill (every item due at Start, within the first credit
+//! window, [`Pacing::prefill`]), then, after Start, the batch starting at item `j` at
+//! `start + t_j − lead` ([`Pacing::due`], [`Plan::due`](super::plan::Plan::due)), never beyond
+//! the device's credit window ([`Pacing::step`]: a batch that finds no credit stalls, and the
+//! session gives up after the credit timeout). A Telemetry that shows an item lost sends the
+//! pacing back to it ([`Pacing::check_lost`], [`super::resend`]); the go-back is written at
+//! once, up to where it left off.
+//!
+//! The pacing decides and counts; the run (`flow.rs`) waits, handles device messages meanwhile
+//! and writes: it waits through its port and busy-waits the last `StreamConfig::spin` (200 µs)
+//! before a due instant ([`Port::spin_until`](super::port::Port::spin_until)).
 
-use super::flow::Run;
 use super::plan::Plan;
-use super::port::Port;
 use super::resend::GoBackN;
-use super::served::{served_window, ServedCheck, MAX_WINDOW};
-use super::window::Window;
-use super::Progress;
-use super::StreamError;
-use margemu_protocol::link::{Message, Start};
+use super::{JitterStats, Lateness, LinkStats, StreamError};
+use margemu_protocol::link::{DeviceState, Telemetry};
 
-/// Batches predicted beyond the next one to write.
-const PREDICT_AHEAD: u64 = 2;
+/// What to do about the next item once its instant has come.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Step {
+    /// Write the batch of `n` items from [`Pacing::next`]; `paced`: it was not held back by
+    /// the credit window, so it counts in the jitter figures.
+    Write {
+        /// Items in the batch.
+        n: u64,
+        /// Not held back by credit.
+        paced: bool,
+    },
+    /// No credit: wait for device messages until this host time (the credit timeout).
+    Stalled(u64),
+}
 
-impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
-    /// Sets the plan from the device's HelloAck ([`Plan::new`]: batch size and lead), and the
-    /// windows of what the session keeps: the write times of the last `buffer_capacity`
-    /// items and a batch (a go-back starts no earlier than the credit window, `limit −
-    /// buffer_capacity`, and nothing was written at or beyond `limit`); the items themselves,
-    /// predicted up to [`PREDICT_AHEAD`] batches beyond the next to write (so a go-back always
-    /// finds them); the Served check's ([`served_window`], those predicted ahead counted as
-    /// buffered).
-    pub(super) fn plan_pacing(&mut self) {
-        self.plan = Plan::new(self.session, self.reports.ack.as_ref());
-        let (batch, capacity) = (self.plan.batch as usize, self.plan.capacity as usize);
-        let ahead = PREDICT_AHEAD as usize * batch;
-        let buffered = u32::try_from(capacity.saturating_add(ahead)).unwrap_or(u32::MAX);
-        let hold = u32::try_from(self.plan.hold).unwrap_or(u32::MAX);
-        self.served = ServedCheck::new(self.total(), served_window(buffered, hold));
-        let items = capacity.saturating_add(batch).min(MAX_WINDOW);
-        self.go_back = GoBackN::new(items);
-        self.session.prediction.items = Window::new(items + ahead + batch);
+/// The pacing state of a run (see the module docs).
+pub(super) struct Pacing {
+    /// The next item to write.
+    next: u64,
+    /// When each recent item was last written (its window set by the plan); the go-backs.
+    go_back: GoBackN,
+    /// When Start was written, host ns: scene time 0.
+    start: Option<u64>,
+    /// Since when a due batch has been waiting for credit, host ns.
+    stall: Option<u64>,
+    /// How late the paced batches' writes started.
+    late: Lateness,
+    /// How late the same writes completed.
+    written_late: Lateness,
+    max_late_ns: i64,
+    /// Times a due batch had to wait for credit.
+    credit_stalls: u64,
+    /// Bytes written to the port: all, and those of sample batches with their item bytes.
+    link: LinkStats,
+}
+
+impl Pacing {
+    /// Nothing written yet.
+    pub(super) fn new() -> Self {
+        Self {
+            next: 0,
+            go_back: GoBackN::new(1),
+            start: None,
+            stall: None,
+            late: Lateness::default(),
+            written_late: Lateness::default(),
+            max_late_ns: 0,
+            credit_stalls: 0,
+            link: LinkStats::default(),
+        }
     }
 
-    /// Host time at which the batch starting at item `j` is due (`None` before Start).
-    fn due(&self, j: u64) -> Option<u64> {
-        Some(self.plan.due(self.start?, j))
+    /// Keeps the write times the plan set from the HelloAck asks for
+    /// ([`Plan::write_times_kept`]), before anything is written.
+    pub(super) fn plan(&mut self, plan: &Plan) {
+        self.go_back = GoBackN::new(plan.write_times_kept());
     }
 
-    /// Writes items `next .. next + n`. A batch `due` at an instant is logged with how late its
-    /// write completed against it; for a `paced` one (not held back by credit, not a resend) the
-    /// jitter figures keep how late the write started (the pacing) and completed (the port's
-    /// share added).
-    fn write_batch(&mut self, n: u64, due: Option<u64>, paced: bool) -> Result<(), StreamError> {
-        let first = self.next;
-        let resend = first < self.go_back.high();
-        self.session.predict_through(first + n, &mut self.served)?;
-        let started = self.now();
-        let len = self
-            .session
-            .emit_batch(first, n, &mut self.encoder, &mut self.wire);
-        self.write_wire(len)?;
-        self.figures.link.batch_frames += 1;
-        self.figures.link.batch_wire_bytes += len as u64;
-        self.figures.link.item_bytes += n * self.session.item_len();
-        let sent_at = self.now();
-        let send_ns = Self::host_ns(sent_at);
-        let late = |due: u64, at: u64| at.saturating_sub(due) as i64;
-        let late_ns = due.map(|due| late(due, sent_at));
-        self.go_back.written(first, n, send_ns);
-        if let (Some(due), true) = (due, paced && !resend) {
-            let late = |at: u64| late(due, at);
-            self.figures.late.record(late(started));
-            self.figures.written_late.record(late(sent_at));
-            self.figures.max_late_ns = self.figures.max_late_ns.max(late(started));
-        }
-        self.next += n;
-        let late_ns = late_ns.filter(|_| !resend);
-        let logged = self.session.log_sent(first, n, send_ns, late_ns, resend);
-        logged.map_err(self.log_err())
+    /// The next item to write.
+    pub(super) fn next(&self) -> u64 {
+        self.next
     }
 
-    /// Prefill, Start, then every item at its due instant (and every go-back at once).
-    pub(super) fn stream(&mut self) -> Result<(), StreamError> {
-        let total = self.plan.stream_len;
-        let lead_ns = self.plan.lead_ns;
-        let rate = self.plan.item_rate;
-        // Prefill: every item due at Start, within the first window.
-        while self.next < total
-            && rate.sample_time_ns(self.next) <= lead_ns
-            && self.reports.credit.available(self.next) > 0
-        {
-            let n = self
-                .plan
-                .batch
-                .min(self.reports.credit.available(self.next))
-                .min(total - self.next);
-            self.write_batch(n, None, false)?;
-        }
-        // The device serves samples 0..total and stops by itself at the scene's end.
-        self.send(&Message::Start(Start::scene(0, self.total())))?;
-        let start = self.now();
-        self.start = Some(start);
-        let start_ns = Self::host_ns(start);
-        self.event(
-            "start",
-            &format!("start_host_ns {start_ns}; prefill {}", self.next),
-        )?;
-        let mut stall = None;
-        while self.next < total {
-            self.send_next(&mut stall)?;
-        }
-        Ok(())
+    /// Whether items remain to be written (a go-back included).
+    pub(super) fn has_next(&self, plan: &Plan) -> bool {
+        self.next < plan.stream_len()
     }
 
-    /// Waits for the next item's instant (handling device messages meanwhile) and writes its
-    /// batch, within the credit window; a go-back is written at once, up to where it left off.
-    fn send_next(&mut self, stall: &mut Option<u64>) -> Result<(), StreamError> {
-        let total = self.plan.stream_len;
-        self.report(false);
-        // Predicted ahead while there is time, so a due batch never waits for its prediction.
-        let ahead = (self.next + PREDICT_AHEAD * self.plan.batch).min(total);
-        self.session.predict_through(ahead, &mut self.served)?;
-        let due = self.due(self.next).expect("started");
-        let spin = self.plan.spin_ns;
-        if self.now() + spin < due {
-            return self.pump(due - spin);
-        }
-        self.port.spin_until(due);
-        // The batch goes out first; device messages wait, unless the window is short.
-        let wanted = self.plan.batch.min(total - self.next);
-        if self.reports.credit.available(self.next) < wanted {
-            self.handle_waiting()?;
-        }
-        let available = self.reports.credit.available(self.next);
+    /// Whether the next item was written before (a go-back).
+    pub(super) fn resending(&self) -> bool {
+        self.next < self.go_back.high()
+    }
+
+    /// The items to predict before the next batch is due: up to [`Plan::ahead`] beyond the
+    /// next to write.
+    pub(super) fn predict_to(&self, plan: &Plan) -> u64 {
+        (self.next + plan.ahead()).min(plan.stream_len())
+    }
+
+    /// The next prefill batch's size while `available` items of credit remain (`None`: the
+    /// prefill is done): the items due at Start, within the credit window.
+    pub(super) fn prefill(&self, plan: &Plan, available: u64) -> Option<u64> {
+        let total = plan.stream_len();
+        let due = self.next < total && plan.due_at_start(self.next);
+        (due && available > 0).then(|| plan.batch().min(available).min(total - self.next))
+    }
+
+    /// Start was written at host time `at`.
+    pub(super) fn started(&mut self, at: u64) {
+        self.start = Some(at);
+    }
+
+    /// When Start was written, host ns.
+    pub(super) fn start(&self) -> Option<u64> {
+        self.start
+    }
+
+    /// Host time at which the next batch is due (`None` before Start).
+    pub(super) fn due(&self, plan: &Plan) -> Option<u64> {
+        Some(plan.due(self.start?, self.next))
+    }
+
+    /// The items the next batch would carry with all the credit it needs.
+    pub(super) fn wanted(&self, plan: &Plan) -> u64 {
+        plan.batch().min(plan.stream_len() - self.next)
+    }
+
+    /// What to do at host time `now`, once the next batch's instant has come, with `available`
+    /// items of credit: write it (a go-back up to where it left off), or wait for credit (a
+    /// credit stall). Fails once the batch has waited the credit timeout.
+    pub(super) fn step(
+        &mut self,
+        plan: &Plan,
+        available: u64,
+        now: u64,
+    ) -> Result<Step, StreamError> {
         if available == 0 {
-            let now = self.now();
-            let since = *stall.get_or_insert_with(|| {
-                self.figures.credit_stalls += 1;
+            let since = *self.stall.get_or_insert_with(|| {
+                self.credit_stalls += 1;
                 now
             });
-            let timeout = self.plan.credit_timeout;
+            let timeout = plan.credit_timeout();
             let limit = since + timeout.as_nanos() as u64;
             if now >= limit {
                 return Err(StreamError::CreditTimeout {
@@ -145,69 +147,210 @@ impl<L: Port, P: FnMut(&Progress)> Run<'_, L, P> {
                     timeout,
                 });
             }
-            return self.pump(limit);
+            return Ok(Step::Stalled(limit));
         }
         // A batch held back by the credit window is late because of the device, not of the
         // pacing: logged, but left out of the jitter figures.
-        let paced = stall.take().is_none();
-        let mut n = self.plan.batch.min(available).min(total - self.next);
-        if self.next < self.go_back.high() {
+        let paced = self.stall.take().is_none();
+        let mut n = plan
+            .batch()
+            .min(available)
+            .min(plan.stream_len() - self.next);
+        if self.resending() {
             n = n.min(self.go_back.high() - self.next);
         }
-        self.write_batch(n, Some(due), paced)
+        Ok(Step::Write { n, paced })
     }
 
-    /// Waits until the device reports serving sample `last` (a Served entry or a Telemetry), or
-    /// `deadline`.
-    fn await_served(&mut self, last: u64, deadline: u64) -> Result<(), StreamError> {
-        let served = |run: &Self| {
-            run.served.stats().last_index >= Some(last)
-                || run
-                    .reports
-                    .telemetry
-                    .is_some_and(|t| t.samples_served > 0 && t.last_served_index >= last)
+    /// A frame of `len` bytes was written.
+    pub(super) fn wrote(&mut self, len: usize) {
+        self.link.wire_bytes += len as u64;
+    }
+
+    /// The frame written last, of `len` bytes, was a batch carrying `item_bytes`.
+    pub(super) fn wrote_batch(&mut self, len: usize, item_bytes: u64) {
+        self.link.batch_frames += 1;
+        self.link.batch_wire_bytes += len as u64;
+        self.link.item_bytes += item_bytes;
+    }
+
+    /// The batch of the next `n` items was written: its write started at host time `started`
+    /// and completed at `sent_at`. A batch `due` at an instant gets how late its write
+    /// completed against it (`None` for a resend: what the log says); for a `paced` one (not
+    /// held back by credit, not a resend) the jitter figures keep how late the write started
+    /// (the pacing) and completed (the port's share added).
+    pub(super) fn written(
+        &mut self,
+        n: u64,
+        due: Option<u64>,
+        paced: bool,
+        started: u64,
+        sent_at: u64,
+    ) -> Option<i64> {
+        let resend = self.resending();
+        let late = |due: u64, at: u64| at.saturating_sub(due) as i64;
+        let late_ns = due.map(|due| late(due, sent_at));
+        self.go_back.written(self.next, n, sent_at as i64);
+        if let (Some(due), true) = (due, paced && !resend) {
+            let late = |at: u64| late(due, at);
+            self.late.record(late(started));
+            self.written_late.record(late(sent_at));
+            self.max_late_ns = self.max_late_ns.max(late(started));
+        }
+        self.next += n;
+        late_ns.filter(|_| !resend)
+    }
+
+    /// Goes back to the device's `next_index` if its Telemetry `t` shows that item lost: the
+    /// device holds items beyond it, which a FIFO line delivered after it (or, once every item
+    /// was written, nothing more is coming), and it was last written long enough before the
+    /// report (see [`super::resend`]). Returns the `events.csv` row to log (`resend`, or
+    /// `resend_out_of_window` for an item older than the write times kept).
+    pub(super) fn check_lost(
+        &mut self,
+        plan: &Plan,
+        t: &Telemetry,
+    ) -> Option<(&'static str, String)> {
+        let contiguous = t
+            .next_index
+            .saturating_sub(t.credit_limit.saturating_sub(plan.capacity()));
+        let all_written = self.go_back.high() == plan.stream_len();
+        let beyond = u64::from(t.buffer_level) > contiguous || all_written;
+        let running = t.state == DeviceState::Running;
+        let (Some(start), true, true) = (self.start, running, beyond) else {
+            return None;
         };
-        while !served(self) && self.now() < deadline {
-            self.pump(deadline)?;
+        let (next_index, tau) = (t.next_index, t.time_ns);
+        let margin = plan.resend_after_ns() as i64;
+        let seen_by = start as i64 + tau as i64 - margin;
+        match self.go_back.lost(next_index, seen_by) {
+            Some(hole) if hole < self.next => {
+                let detail = format!(
+                    "device next_index {hole} at its scene time {tau} ns, {} items buffered; going back from {}",
+                    t.buffer_level, self.next
+                );
+                self.next = hole;
+                self.go_back.rewound();
+                Some(("resend", detail))
+            }
+            None if next_index < self.next && self.go_back.forgotten(next_index) => {
+                let detail = format!(
+                    "device next_index {next_index} at its scene time {tau} ns is older than the \
+                     items kept (from {}): not resent",
+                    self.go_back.forgotten_below()
+                );
+                Some(("resend_out_of_window", detail))
+            }
+            _ => None,
         }
-        Ok(())
     }
 
-    /// Sends Stop half an output period after the last sample's instant, on the session's clock
-    /// ([`Plan::stop_at`]).
-    /// The device stops by itself at the scene's end (Start's `end_index`), so it never serves
-    /// an instant after the last sample, however late Stop arrives; Stop confirms that. In
-    /// source images a Stop that arrives early is graceful (the device serves what it still
-    /// holds). In source model it stops at once, and the device's clock lags the host's by the
-    /// Start's delivery time, so the host first waits until the device reports serving the last
-    /// sample. Then it waits for Telemetry in the stopped state.
-    pub(super) fn finish(&mut self) -> Result<(), StreamError> {
-        let drain = self.plan.drain_ns;
-        let spin = self.plan.spin_ns;
-        let stop_at = self.start.and_then(|start| self.plan.stop_at(start));
-        if let Some(stop_at) = stop_at {
-            let mut stall = None;
-            while self.now() + spin < stop_at {
-                if self.next < self.plan.stream_len {
-                    self.send_next(&mut stall)?; // a go-back
-                    continue;
-                }
-                self.report(false);
-                self.pump(stop_at - spin)?;
-            }
-            self.port.spin_until(stop_at);
-            if self.plan.stops_at_once {
-                let last = self.total() - 1;
-                self.await_served(last, self.now() + drain)?;
-            }
+    /// Items written at least once.
+    pub(super) fn sent(&self) -> u64 {
+        self.go_back.high()
+    }
+
+    /// Go-backs so far.
+    pub(super) fn rewinds(&self) -> u64 {
+        self.go_back.rewinds()
+    }
+
+    /// Items written more than once so far.
+    pub(super) fn resent(&self) -> u64 {
+        self.go_back.resent()
+    }
+
+    /// How late the last paced batch's write started, ns.
+    pub(super) fn last_late_ns(&self) -> i64 {
+        self.late.last_ns()
+    }
+
+    /// The latest a paced batch's write started so far, ns.
+    pub(super) fn max_late_ns(&self) -> i64 {
+        self.max_late_ns
+    }
+
+    /// How late the paced batches' writes started.
+    pub(super) fn jitter(&self) -> JitterStats {
+        self.late.stats()
+    }
+
+    /// How late the paced batches' writes completed.
+    pub(super) fn written_jitter(&self) -> JitterStats {
+        self.written_late.stats()
+    }
+
+    /// Times a due batch had to wait for credit.
+    pub(super) fn credit_stalls(&self) -> u64 {
+        self.credit_stalls
+    }
+
+    /// Bytes written.
+    pub(super) fn link(&self) -> LinkStats {
+        self.link
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use margemu_protocol::link::Rate;
+
+    fn plan() -> Plan {
+        Plan::example(1000, Rate::new(1000, 1).unwrap()) // batches of 32, 96 ms lead
+    }
+
+    #[test]
+    fn the_prefill_takes_the_items_due_at_start_within_the_credit() {
+        let (plan, mut p) = (plan(), Pacing::new());
+        assert_eq!(p.prefill(&plan, 0), None, "no credit");
+        assert_eq!(p.prefill(&plan, 20), Some(20));
+        for _ in 0..3 {
+            assert_eq!(p.prefill(&plan, 1000), Some(32));
+            p.written(32, None, false, 0, 0);
         }
-        self.stop_sent = true;
-        self.send(&Message::Stop)?;
-        let deadline = self.now() + drain;
-        while self.now() < deadline && !self.device_stopped() {
-            self.pump(deadline)?;
-        }
-        self.report(true);
-        self.log_stop_outcome()
+        assert_eq!(
+            p.prefill(&plan, 1000),
+            Some(32),
+            "item 96 is due at 96 ms: the lead"
+        );
+        p.written(32, None, false, 0, 0);
+        assert_eq!(p.prefill(&plan, 1000), None, "item 128 is not");
+        assert_eq!(p.jitter().batches, 0, "the prefill is not paced");
+    }
+
+    #[test]
+    fn a_batch_without_credit_stalls_until_the_credit_timeout() {
+        let (plan, mut p) = (plan(), Pacing::new());
+        p.started(5);
+        assert_eq!(p.due(&plan), Some(5));
+        let timeout = 2_000_000_000;
+        assert_eq!(p.step(&plan, 0, 10).unwrap(), Step::Stalled(10 + timeout));
+        assert_eq!(p.step(&plan, 0, 20).unwrap(), Step::Stalled(10 + timeout));
+        assert_eq!(p.credit_stalls(), 1, "one stall, however long");
+        let held = p.step(&plan, 8, 30).unwrap();
+        assert_eq!(held, Step::Write { n: 8, paced: false });
+        assert_eq!(
+            p.step(&plan, 100, 40).unwrap(),
+            Step::Write { n: 32, paced: true }
+        );
+        p.step(&plan, 0, 50).unwrap();
+        let err = p.step(&plan, 0, 50 + timeout).unwrap_err();
+        assert!(
+            matches!(err, StreamError::CreditTimeout { index: 0, .. }),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn paced_batches_keep_how_late_they_were_written() {
+        let (plan, mut p) = (plan(), Pacing::new());
+        p.started(0);
+        assert_eq!(p.written(32, Some(100), true, 150, 400), Some(300));
+        assert_eq!(p.written(32, Some(200), false, 900, 1000), Some(800));
+        let j = p.jitter();
+        assert_eq!((j.batches, j.max_ns, p.max_late_ns()), (1, 50, 50));
+        assert_eq!(p.written_jitter().max_ns, 300);
+        assert_eq!((p.next(), p.sent(), p.has_next(&plan)), (64, 64, true));
     }
 }

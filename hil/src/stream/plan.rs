@@ -1,66 +1,82 @@
 //! [`Plan`]: everything a streaming session keeps fixed once the device has answered Hello (the
 //! scene's counts and rates, the batch size and lead the device's capabilities allow, the
-//! timeouts), set once by the run and never changed; the run's mutable state lives in `Run`.
+//! windows of what the session keeps, the timeouts), set once by the run (`flow.rs`) and never
+//! changed; the run's mutable state lives in its parts (`pacing.rs`, `reports.rs`,
+//! `ending.rs`).
 //!
 //! Items are written in batches of up to `StreamConfig::batch`, capped by the frame, by the
 //! device's `max_batch` and by a quarter of its buffer. The lead is `StreamConfig::lead` capped
 //! at 3/8 of the device's buffer (so a due batch normally finds the credit it needs: the device
 //! grants its window a quarter of its buffer at a time).
+//!
+//! What the session keeps is bounded by the device's buffer: the write times of the last
+//! `buffer_capacity` items and a batch (a go-back starts no earlier than the credit window,
+//! `limit − buffer_capacity`, and nothing was written at or beyond `limit`); the items
+//! themselves, predicted up to [`PREDICT_AHEAD`] batches beyond the next to write (so a go-back
+//! always finds them); the Served check's window ([`served_window`], the items predicted ahead
+//! counted as buffered).
 
-use super::session::Session;
+use super::served::{served_window, MAX_WINDOW};
+use super::session::StreamConfig;
+use super::source::Source;
 use margemu_protocol::link::{HelloAck, Rate};
 use std::time::Duration;
+
+/// Batches predicted beyond the next one to write.
+const PREDICT_AHEAD: u64 = 2;
 
 /// The fixed parameters of a session (see the module docs). Times are ns.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Plan {
     /// Output samples in the scene.
-    pub(super) samples: u64,
+    samples: u64,
     /// Items to stream (output samples, or kinematics samples in source model).
-    pub(super) stream_len: u64,
+    stream_len: u64,
     /// The scene's output rate.
-    pub(super) rate: Rate,
+    rate: Rate,
     /// The rate of the items.
-    pub(super) item_rate: Rate,
+    item_rate: Rate,
     /// Output samples per item.
-    pub(super) hold: u64,
+    hold: u64,
     /// The device stops at once on Stop (source model) rather than serving what it holds.
-    pub(super) stops_at_once: bool,
+    stops_at_once: bool,
     /// Items per batch.
-    pub(super) batch: u64,
+    batch: u64,
     /// How far ahead of its first item's instant a batch is due.
-    pub(super) lead_ns: u64,
+    lead_ns: u64,
     /// The device's buffer, items (0 before the handshake).
-    pub(super) capacity: u64,
+    capacity: u64,
     /// The last stretch before a due instant that is busy-waited.
-    pub(super) spin_ns: u64,
+    spin_ns: u64,
+    /// The session number sent in Hello.
+    session_id: u32,
     /// How long to wait for HelloAck and for the first credit window.
-    pub(super) hello_timeout_ns: u64,
+    hello_timeout: Duration,
     /// How long a due batch may wait for credit.
-    pub(super) credit_timeout: Duration,
+    credit_timeout: Duration,
     /// How long to wait for the last sample served and for the Stop confirmed.
-    pub(super) drain_ns: u64,
+    drain_ns: u64,
     /// How long after its last write an item the device reports lost may be written again.
-    pub(super) resend_after_ns: u64,
+    resend_after_ns: u64,
 }
 
 impl Plan {
     /// The plan before the device has answered: one item per batch, no lead, no buffer.
-    pub(super) fn before_handshake(session: &Session) -> Self {
-        let c = &session.config;
+    pub(super) fn before_handshake(source: &Source, c: &StreamConfig) -> Self {
         let ns = |d: Duration| d.as_nanos() as u64;
         Self {
-            samples: session.samples,
-            stream_len: session.stream_len(),
-            rate: session.rate,
-            item_rate: session.item_rate(),
-            hold: session.hold(),
-            stops_at_once: session.stops_at_once(),
+            samples: source.samples(),
+            stream_len: source.stream_len(),
+            rate: source.rate(),
+            item_rate: source.item_rate(),
+            hold: source.hold(),
+            stops_at_once: source.stops_at_once(),
             batch: 1,
             lead_ns: 0,
             capacity: 0,
             spin_ns: ns(c.spin),
-            hello_timeout_ns: ns(c.hello_timeout),
+            session_id: c.session_id,
+            hello_timeout: c.hello_timeout,
             credit_timeout: c.credit_timeout,
             drain_ns: ns(c.drain_timeout),
             resend_after_ns: ns(c.resend_after),
@@ -69,25 +85,24 @@ impl Plan {
 
     /// The plan for a device that answered `ack` (a device without one is planned as one of
     /// batch 1 and buffer 4).
-    pub(super) fn new(session: &Session, ack: Option<&HelloAck>) -> Self {
+    pub(super) fn new(source: &Source, config: &StreamConfig, ack: Option<&HelloAck>) -> Self {
         let (max_batch, capacity) = ack.map_or((1, 4), |a| {
             let c = a.capabilities;
             (usize::from(c.max_batch), c.buffer_capacity as usize)
         });
-        let batch = session
-            .config
+        let batch = config
             .batch
             .min(max_batch)
-            .min(session.max_per_frame())
+            .min(source.max_per_frame())
             .min(capacity / 4)
             .max(1);
-        let window = session.item_rate().sample_time_ns(3 * capacity as u64 / 8);
-        let lead = session.config.lead.min(Duration::from_nanos(window));
+        let window = source.item_rate().sample_time_ns(3 * capacity as u64 / 8);
+        let lead = config.lead.min(Duration::from_nanos(window));
         Self {
             batch: batch as u64,
             lead_ns: lead.as_nanos() as u64,
             capacity: capacity as u64,
-            ..Self::before_handshake(session)
+            ..Self::before_handshake(source, config)
         }
     }
 
@@ -96,6 +111,103 @@ impl Plan {
     pub(super) fn due(&self, start: u64, j: u64) -> u64 {
         let t = self.item_rate.sample_time_ns(j);
         (start + t).saturating_sub(self.lead_ns).max(start)
+    }
+
+    /// Output samples in the scene.
+    pub(super) fn samples(&self) -> u64 {
+        self.samples
+    }
+
+    /// Items to stream (output samples, or kinematics samples in source model).
+    pub(super) fn stream_len(&self) -> u64 {
+        self.stream_len
+    }
+
+    /// The scene's output rate.
+    pub(super) fn rate(&self) -> Rate {
+        self.rate
+    }
+
+    /// Whether item `j` is due at Start: its instant is within the lead.
+    pub(super) fn due_at_start(&self, j: u64) -> bool {
+        self.item_rate.sample_time_ns(j) <= self.lead_ns
+    }
+
+    /// Whether the device stops at once on Stop (source model).
+    pub(super) fn stops_at_once(&self) -> bool {
+        self.stops_at_once
+    }
+
+    /// Items per batch.
+    pub(super) fn batch(&self) -> u64 {
+        self.batch
+    }
+
+    /// How far ahead of its first item's instant a batch is due.
+    pub(super) fn lead(&self) -> Duration {
+        Duration::from_nanos(self.lead_ns)
+    }
+
+    /// The device's buffer, items (0 before the handshake).
+    pub(super) fn capacity(&self) -> u64 {
+        self.capacity
+    }
+
+    /// The last stretch before a due instant that is busy-waited, ns.
+    pub(super) fn spin_ns(&self) -> u64 {
+        self.spin_ns
+    }
+
+    /// The session number sent in Hello.
+    pub(super) fn session_id(&self) -> u32 {
+        self.session_id
+    }
+
+    /// How long to wait for HelloAck and for the first credit window.
+    pub(super) fn hello_timeout(&self) -> Duration {
+        self.hello_timeout
+    }
+
+    /// How long a due batch may wait for credit.
+    pub(super) fn credit_timeout(&self) -> Duration {
+        self.credit_timeout
+    }
+
+    /// How long to wait for the last sample served and for the Stop confirmed, ns.
+    pub(super) fn drain_ns(&self) -> u64 {
+        self.drain_ns
+    }
+
+    /// How long after its last write an item the device reports lost may be written again, ns.
+    pub(super) fn resend_after_ns(&self) -> u64 {
+        self.resend_after_ns
+    }
+
+    /// Items predicted beyond the next one to write.
+    pub(super) fn ahead(&self) -> u64 {
+        PREDICT_AHEAD * self.batch
+    }
+
+    /// How many of the newest items' write times are kept (what a go-back can reach).
+    pub(super) fn write_times_kept(&self) -> usize {
+        let (batch, capacity) = (self.batch as usize, self.capacity as usize);
+        capacity.saturating_add(batch).min(MAX_WINDOW)
+    }
+
+    /// How many of the newest items are kept: those a go-back can reach, those predicted ahead
+    /// and a batch.
+    pub(super) fn items_kept(&self) -> usize {
+        let batch = self.batch as usize;
+        self.write_times_kept() + PREDICT_AHEAD as usize * batch + batch
+    }
+
+    /// How many predictions the Served check keeps ([`served_window`]).
+    pub(super) fn served_window(&self) -> usize {
+        let buffered =
+            (self.capacity as usize).saturating_add(PREDICT_AHEAD as usize * self.batch as usize);
+        let buffered = u32::try_from(buffered).unwrap_or(u32::MAX);
+        let hold = u32::try_from(self.hold).unwrap_or(u32::MAX);
+        served_window(buffered, hold)
     }
 
     /// Host time at which Stop is due, for a Start written at host time `start`: half an output
@@ -111,11 +223,11 @@ impl Plan {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn plan(samples: u64, rate: Rate) -> Plan {
-        Plan {
+impl Plan {
+    /// A plan for unit tests: `samples` images at `rate`, batches of 32, a 96 ms lead, a
+    /// buffer of 256, a credit timeout of 2 s, no spin and no resend margin.
+    pub(super) fn example(samples: u64, rate: Rate) -> Self {
+        Self {
             samples,
             stream_len: samples,
             rate,
@@ -126,11 +238,21 @@ mod tests {
             lead_ns: 96_000_000,
             capacity: 256,
             spin_ns: 0,
-            hello_timeout_ns: 0,
-            credit_timeout: Duration::ZERO,
+            session_id: 0,
+            hello_timeout: Duration::ZERO,
+            credit_timeout: Duration::from_secs(2),
             drain_ns: 0,
             resend_after_ns: 0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(samples: u64, rate: Rate) -> Plan {
+        Plan::example(samples, rate)
     }
 
     #[test]

@@ -1,5 +1,7 @@
 //! [`Session`]: the host side of one streaming run (handshake, configuration, prefill, paced
-//! batches, stop), over any byte port.
+//! batches, stop), over any byte port. It owns the settings, what is streamed (`source.rs`:
+//! the items and their lazy prediction) and the log writer (`logger.rs`), and hands itself to
+//! the run (`flow.rs`), which reaches them only through the session's methods.
 
 use super::clock::SystemClock;
 use super::flow::Run;
@@ -8,16 +10,17 @@ use super::log::{SessionLog, SENT_COLUMNS, SENT_KINEMATICS_COLUMNS};
 use super::logger::Logger;
 use super::meta::metadata;
 use super::model::predict_model;
+use super::plan::Plan;
 use super::port::{Port, SystemPort};
-use super::source::{Items, Prediction};
+use super::served::ServedCheck;
+use super::source::{Items, Prediction, Source};
 use super::{Progress, StreamError, Summary};
-use margemu_protocol::link::Rate;
+use margemu_protocol::link::{Capabilities, Configure, Encoder, HelloAck, Rate};
 use margemu_sim::rundir::{Completion, CompletionRecord, Status};
-use margemu_sim::scene::chip::ChipSetup;
 use margemu_sim::scene::Scene;
 use std::io::{Read, Write};
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -94,19 +97,14 @@ impl Default for StreamConfig {
 /// One streaming run of one scene: its prediction (read lazily, a bounded window at a time),
 /// its settings and its log directory.
 pub struct Session {
-    pub(super) config: StreamConfig,
-    pub(super) settings: ImageSettings,
-    /// The chip Configure asks for (the scene's `[chip]`).
-    pub(super) chip: ChipSetup,
-    pub(super) rate: Rate,
-    /// Output samples in the scene.
-    pub(super) samples: u64,
-    pub(super) items: Items,
-    pub(super) prediction: Prediction,
-    pub(super) log: Logger,
-    pub(super) stop: Arc<AtomicBool>,
+    config: StreamConfig,
+    settings: ImageSettings,
+    /// The items and their prediction.
+    source: Source,
+    log: Logger,
+    stop: Arc<AtomicBool>,
     /// Host time 0 of the logs; `None`: when the run begins.
-    pub(super) origin: Option<Instant>,
+    origin: Option<Instant>,
 }
 
 impl Session {
@@ -146,14 +144,11 @@ impl Session {
         };
         let log = SessionLog::create(dir, &meta, sent_columns).map_err(log_err)?;
         let log = Logger::spawn(log).map_err(log_err)?;
+        let source = Source::new(items, prediction, scene.chip, rate, scene.samples());
         Ok(Self {
             config,
             settings,
-            chip: scene.chip,
-            rate,
-            samples: scene.samples(),
-            items,
-            prediction,
+            source,
             log,
             stop: Arc::new(AtomicBool::new(false)),
             origin: None,
@@ -183,12 +178,102 @@ impl Session {
     /// Output samples in the scene (their images: [`predict_images`](super::predict_images)
     /// with [`Session::image_settings`]).
     pub fn sample_count(&self) -> u64 {
-        self.samples
+        self.source.samples()
+    }
+
+    /// The source mode, with the kinematics rate resolved.
+    pub fn source(&self) -> SourceMode {
+        self.source.mode()
     }
 
     /// The register settings the images were computed with.
     pub fn image_settings(&self) -> &ImageSettings {
         &self.settings
+    }
+
+    /// The plan before the device has answered Hello ([`Plan::before_handshake`]).
+    pub(super) fn plan_before_handshake(&self) -> Plan {
+        Plan::before_handshake(&self.source, &self.config)
+    }
+
+    /// The plan for a device that answered `ack` ([`Plan::new`]).
+    pub(super) fn plan(&self, ack: Option<&HelloAck>) -> Plan {
+        Plan::new(&self.source, &self.config, ack)
+    }
+
+    /// Why a device with capabilities `caps` cannot serve this session (`None`: it can).
+    pub(super) fn refusal(&self, caps: &Capabilities) -> Option<String> {
+        self.source.refusal(caps)
+    }
+
+    /// Configure for this session.
+    pub(super) fn configure_message(&self) -> Configure {
+        let period = self.config.telemetry_period.as_nanos() as u64;
+        self.source.configure_message(period)
+    }
+
+    /// Keeps the newest `span` items predicted (`Plan::items_kept`).
+    pub(super) fn keep_items(&mut self, span: usize) {
+        self.source.keep_items(span);
+    }
+
+    /// Predicts items `.. end` ([`Source::predict_through`]).
+    pub(super) fn predict_through(
+        &mut self,
+        end: u64,
+        served: &mut ServedCheck,
+    ) -> Result<(), StreamError> {
+        self.source.predict_through(end, served, &mut self.log)
+    }
+
+    /// Encodes the batch of items `first .. first + n` into `wire`; returns its length.
+    pub(super) fn emit_batch(
+        &self,
+        first: u64,
+        n: u64,
+        encoder: &mut Encoder,
+        wire: &mut [u8],
+    ) -> usize {
+        self.source.emit_batch(first, n, encoder, wire)
+    }
+
+    /// Bytes of one item on the wire (before framing).
+    pub(super) fn item_len(&self) -> u64 {
+        self.source.item_len()
+    }
+
+    /// Logs items `first .. first + n` in `sent.csv`, written at host time `send_ns`.
+    pub(super) fn log_sent(
+        &mut self,
+        first: u64,
+        n: u64,
+        send_ns: i64,
+        late_ns: Option<i64>,
+        resend: bool,
+    ) -> Result<(), StreamError> {
+        let log = &mut self.log;
+        self.source
+            .log_sent(log, first, n, send_ns, late_ns, resend)
+    }
+
+    /// The session's log writer.
+    pub(super) fn logger(&self) -> &Logger {
+        &self.log
+    }
+
+    /// The session's log writer, to queue rows.
+    pub(super) fn logger_mut(&mut self) -> &mut Logger {
+        &mut self.log
+    }
+
+    /// Ends the session but for its logs: the log writer, to close them.
+    pub(super) fn into_logger(self) -> Logger {
+        self.log
+    }
+
+    /// Whether the stop flag ([`Session::stop_flag`]) is set.
+    pub(super) fn stop_requested(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
     }
 
     /// Runs the session on a serial port (a clone of it feeds the receive thread).
@@ -227,15 +312,15 @@ impl Session {
     /// from the port's clock (e.g. a [`VirtualPort`](super::virtual_port::VirtualPort) on a
     /// virtual clock). The port is dropped before the logs are closed.
     pub fn run_with(
-        mut self,
+        self,
         port: impl Port,
         progress: impl FnMut(&Progress),
     ) -> Result<Summary, StreamError> {
-        let mut run = Run::new(&mut self, port, progress);
+        let mut run = Run::new(self, port, progress);
         let result = run.session_flow();
         let end_ns = run.now() as i64;
         let summary = run.summary();
-        drop(run);
+        let mut log = run.into_logger(); // the port is dropped here
         let (status, ended) = match &result {
             Ok(()) => (Status::Complete, "completed".to_string()),
             Err(e @ StreamError::Interrupted) => (Status::Interrupted, e.to_string()),
@@ -252,15 +337,11 @@ impl Session {
             samples_expected: Some(served.samples),
             ended,
         };
-        let logged = self
-            .log
+        let logged = log
             .write(move |log| log.event(end_ns, "end", &detail))
-            .and_then(|()| self.log.end(completion));
+            .and_then(|()| log.end(completion));
         result?;
-        logged.map_err(|source| StreamError::Log {
-            path: self.log.dir().to_path_buf(),
-            source,
-        })?;
+        logged.map_err(|source| log.error(source))?;
         Ok(summary)
     }
 }

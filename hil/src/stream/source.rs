@@ -8,25 +8,27 @@
 //! Item `j` is due at its own instant (the output rate's or the kinematics rate's), and the
 //! device's credit window counts items.
 //!
-//! The items come from the session's [`Prediction`], read in order just before they are
-//! written ([`Session::predict_through`]): each output sample read passes its image's CRC-32C to
-//! the Served check and its truth to `truth.csv`. Only a [`Window`] of the newest items is kept
-//! (the device's buffer capacity and two batches, set by the pacing plan): what a go-back can
-//! still write again.
+//! [`Source`] owns the items of a session and their [`Prediction`], read in order just before
+//! they are written ([`Source::predict_through`]): each output sample read passes its image's
+//! CRC-32C to the Served check and its truth to `truth.csv`. Only a [`Window`] of the newest
+//! items is kept (the device's buffer capacity and four batches, `Plan::items_kept`): what a
+//! go-back can still write again.
 
 use super::images::PredictedSample;
+use super::logger::Logger;
 use super::predictor::Predictions;
 use super::served::ServedCheck;
-use super::session::{Session, SourceMode};
+use super::session::SourceMode;
 use super::window::Window;
 use super::{ModelSample, StreamError};
 use margemu_model::sensor;
 use margemu_protocol::link::{
-    max_images_per_batch, Configure, Encoder, Image, ImageBatch, KinematicsBatch, Message,
-    ModelParams, Modes, Rate, Source, CRC32C, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
+    self, max_images_per_batch, Capabilities, Configure, Encoder, Image, ImageBatch,
+    KinematicsBatch, Message, ModelParams, Modes, Rate, CRC32C, MAX_KINEMATICS_PER_BATCH,
+    TRUTH_LEN,
 };
 use margemu_sim::run::RunError;
-use std::io;
+use margemu_sim::scene::chip::ChipSetup;
 use std::iter::Peekable;
 
 /// The items a session streams.
@@ -59,7 +61,7 @@ type Stream = Box<dyn Iterator<Item = Result<(PredictedSample, Option<Item>), Ru
 pub(super) struct Prediction {
     stream: Peekable<Stream>,
     /// The newest items predicted.
-    pub(super) items: Window<Item>,
+    items: Window<Item>,
     /// Output samples predicted so far.
     outputs: u64,
 }
@@ -85,6 +87,12 @@ impl Prediction {
         }
     }
 
+    /// Keeps the newest `span` items from now on (set once the plan is known, before any is
+    /// predicted).
+    fn keep(&mut self, span: usize) {
+        self.items = Window::new(span);
+    }
+
     /// Waits for the first sample: an error the prediction fails with at once (a reference that
     /// cannot be built, a sensor model refused) is returned here.
     pub(super) fn check_start(&mut self) -> Result<(), StreamError> {
@@ -98,9 +106,50 @@ impl Prediction {
     }
 }
 
-impl Session {
+/// What a session streams: its items, their lazy prediction, and what they follow from (the
+/// chip Configure asks for, the scene's rate and sample count).
+pub(super) struct Source {
+    items: Items,
+    prediction: Prediction,
+    /// The chip Configure asks for (the scene's `[chip]`).
+    chip: ChipSetup,
+    /// The scene's output rate.
+    rate: Rate,
+    /// Output samples in the scene.
+    samples: u64,
+}
+
+impl Source {
+    /// The `items` of a scene of `samples` output samples at `rate` for `chip`, read from
+    /// `prediction`.
+    pub(super) fn new(
+        items: Items,
+        prediction: Prediction,
+        chip: ChipSetup,
+        rate: Rate,
+        samples: u64,
+    ) -> Self {
+        Self {
+            items,
+            prediction,
+            chip,
+            rate,
+            samples,
+        }
+    }
+
+    /// Output samples in the scene.
+    pub(super) fn samples(&self) -> u64 {
+        self.samples
+    }
+
+    /// The scene's output rate.
+    pub(super) fn rate(&self) -> Rate {
+        self.rate
+    }
+
     /// The source mode, with the kinematics rate resolved.
-    pub fn source(&self) -> SourceMode {
+    pub(super) fn mode(&self) -> SourceMode {
         match &self.items {
             Items::Images => SourceMode::Images,
             Items::Kinematics { params, .. } => SourceMode::Model {
@@ -128,12 +177,18 @@ impl Session {
         }
     }
 
+    /// Keeps the newest `span` items predicted (`Plan::items_kept`).
+    pub(super) fn keep_items(&mut self, span: usize) {
+        self.prediction.keep(span);
+    }
+
     /// Reads the prediction until items `.. end` and every output sample they cover are
-    /// predicted: their CRCs go to `served`, their truth to `truth.csv`.
+    /// predicted: their CRCs go to `served`, their truth to `truth.csv` (through `log`).
     pub(super) fn predict_through(
         &mut self,
         end: u64,
         served: &mut ServedCheck,
+        log: &mut Logger,
     ) -> Result<(), StreamError> {
         let target = end.saturating_mul(self.hold()).min(self.samples);
         let p = &mut self.prediction;
@@ -156,15 +211,11 @@ impl Session {
         if truths.is_empty() {
             return Ok(());
         }
-        let written = self.log.write(move |log| log.truth(&truths));
-        written.map_err(|source| StreamError::Log {
-            path: self.log.dir().to_path_buf(),
-            source,
-        })
+        log.queue(move |log| log.truth(&truths))
     }
 
     /// The kept items `first .. first + n` (a go-back never reaches further back than the
-    /// window, see `Run::plan_pacing`).
+    /// window, see `Plan::items_kept`).
     fn items(&self, first: u64, n: u64) -> impl Iterator<Item = Item> + '_ {
         (first..first + n).map(|j| {
             *self
@@ -200,7 +251,7 @@ impl Session {
     }
 
     /// The source the device must support.
-    pub(super) fn required_mode(&self) -> (Modes, &'static str) {
+    fn required_mode(&self) -> (Modes, &'static str) {
         match &self.items {
             Items::Images => (Modes::IMAGES, "it does not take register images"),
             Items::Kinematics { .. } => (
@@ -210,11 +261,27 @@ impl Session {
         }
     }
 
-    /// Configure for this session's chip, rate and source.
+    /// Why a device with capabilities `caps` cannot serve this session (`None`: it can): it
+    /// must emulate the chip, support the source mode, and have batch and buffer space.
+    pub(super) fn refusal(&self, caps: &Capabilities) -> Option<String> {
+        let (mode, no_mode) = self.required_mode();
+        let model = self.chip.model;
+        if !caps.chips.has(model) {
+            Some(format!("it does not emulate the {}", model.part_name()))
+        } else if !caps.modes.contains(mode) {
+            Some(no_mode.to_owned())
+        } else if caps.max_batch == 0 || caps.buffer_capacity == 0 {
+            Some("it announces no batch or buffer space".to_owned())
+        } else {
+            None
+        }
+    }
+
+    /// Configure for this session's chip, rate and source, and a Telemetry period.
     pub(super) fn configure_message(&self, telemetry_period_ns: u64) -> Configure {
         let source = match &self.items {
-            Items::Images => Source::Images,
-            Items::Kinematics { params, .. } => Source::Model(**params),
+            Items::Images => link::Source::Images,
+            Items::Kinematics { params, .. } => link::Source::Model(**params),
         };
         Configure {
             telemetry_period_ns,
@@ -245,21 +312,23 @@ impl Session {
         encoded.expect("a batch within the frame's limits fits")
     }
 
-    /// Logs items `first .. first + n` in `sent.csv`, written at host time `send_ns`.
+    /// Logs items `first .. first + n` in `sent.csv` (through `log`), written at host time
+    /// `send_ns`.
     pub(super) fn log_sent(
-        &mut self,
+        &self,
+        log: &mut Logger,
         first: u64,
         n: u64,
         send_ns: i64,
         late_ns: Option<i64>,
         resend: bool,
-    ) -> io::Result<()> {
+    ) -> Result<(), StreamError> {
         let rate = self.item_rate();
         let rows = first..first + n;
         match &self.items {
             Items::Images => {
                 let images: Vec<Image> = self.items(first, n).filter_map(image_of).collect();
-                self.log.write(move |log| {
+                log.queue(move |log| {
                     rows.zip(&images).try_for_each(|(j, image)| {
                         let t_ns = rate.sample_time_ns(j);
                         log.sent_image(j, t_ns, send_ns, late_ns, image, resend)
@@ -268,7 +337,7 @@ impl Session {
             }
             Items::Kinematics { .. } => {
                 let kinematics: Vec<_> = self.items(first, n).filter_map(kinematics_of).collect();
-                self.log.write(move |log| {
+                log.queue(move |log| {
                     rows.zip(&kinematics).try_for_each(|(j, k)| {
                         let t_ns = rate.sample_time_ns(j);
                         log.sent_kinematics(j, t_ns, send_ns, late_ns, k, resend)
