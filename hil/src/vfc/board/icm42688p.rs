@@ -34,7 +34,7 @@
 //! **Axes.** The body frame is the chip's accel/gyro frame (the chip is mounted with the
 //! plate's axes, as the MPU-9250 is); there is no magnetometer ([`to_body`]).
 
-use super::Reading;
+use super::{on_bus, Reading};
 use crate::bus::{self, Shared};
 use crate::vfc::axes::BodySample;
 use icm426xx::{Config, InterruptMode, InterruptPolarity, OutputDataRate, Ready, ICM42688};
@@ -112,14 +112,6 @@ pub struct Board {
     slot: Shared<Chip>,
     driver: Driver,
     overflows: u64,
-}
-
-/// Runs `f` with the device's `chip` in `slot` (the adapter's target), then puts it back.
-fn on_bus<R>(slot: &Shared<Chip>, chip: &mut Chip, f: impl FnOnce() -> R) -> R {
-    std::mem::swap(chip, &mut *slot.borrow_mut());
-    let result = f();
-    std::mem::swap(chip, &mut *slot.borrow_mut());
-    result
 }
 
 /// The driver's sample in the chip's axes; `None` for a packet without accelerometer or

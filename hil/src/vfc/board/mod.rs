@@ -194,3 +194,12 @@ impl Board {
         }
     }
 }
+
+/// Runs `f` with the device's `chip` in `slot` (the bus adapters' target), then puts it back:
+/// how a board's transactions reach the chip the firmware's device owns.
+fn on_bus<C, R>(slot: &crate::bus::Shared<C>, chip: &mut C, f: impl FnOnce() -> R) -> R {
+    std::mem::swap(chip, &mut *slot.borrow_mut());
+    let result = f();
+    std::mem::swap(chip, &mut *slot.borrow_mut());
+    result
+}

@@ -44,7 +44,7 @@
 //! with the configured [`MagAlignment`] ([`to_body`], [`crate::vfc::axes`]), by default the chip
 //! module's own mapping.
 
-use super::Reading;
+use super::{on_bus, Reading};
 use crate::bus::{self, Shared};
 use crate::vfc::axes::{BodySample, MagAlignment};
 use embedded_hal_compat::ReverseCompat;
@@ -187,14 +187,6 @@ pub struct Board {
     /// The conversion of the chip as the board set it up (full scales, the fuse-ROM ASA).
     conversion: ImageConfig,
     overflows: u64,
-}
-
-/// Runs `f` with the device's `chip` in `slot` (the adapters' target), then puts it back.
-fn on_bus<R>(slot: &Shared<Chip>, chip: &mut Chip, f: impl FnOnce() -> R) -> R {
-    std::mem::swap(chip, &mut *slot.borrow_mut());
-    let result = f();
-    std::mem::swap(chip, &mut *slot.borrow_mut());
-    result
 }
 
 impl Board {
