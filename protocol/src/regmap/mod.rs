@@ -8,7 +8,10 @@
 //!   ([`mpu6xxx::image`]);
 //! - [`ak8963`]: the same for the AK8963 magnetometer die behind the MPU-9250's auxiliary bus;
 //! - [`icm42688p`]: the TDK InvenSense ICM-42688-P: banks 0–4, full scales, output rates, FIFO
-//!   packet sizes, conversions (16- and 20-bit) and its 32-byte register image.
+//!   packet sizes, conversions (16- and 20-bit) and its 32-byte register image;
+//! - [`bmi270`]: the Bosch BMI270: register map, access masks, ranges, output rates, the
+//!   configuration upload's registers and the conversions (little-endian data, temperature,
+//!   sensor time).
 //!
 //! Both the firmware (which serves these values) and the host (which predicts what a driver
 //! reads) call the same functions, so they agree bit for bit.
@@ -20,6 +23,7 @@
 //! ```
 
 pub mod ak8963;
+pub mod bmi270;
 pub mod icm42688p;
 pub mod mpu6xxx;
 
