@@ -25,11 +25,14 @@
 //!   mode, the MPU-6500, the MPU-6000 and the ICM-20602);
 //! - [`Ak8963`] on its own, as an [`I2cTarget`];
 //! - [`Icm42688p`]: the TDK InvenSense ICM-42688-P (banks 0–4, 2 KB FIFO with 16- and 20-bit
-//!   packets, INT1/INT2).
+//!   packets, INT1/INT2);
+//! - [`bmi270::Bmi270`]: the Bosch BMI270 (SPI with its dummy byte and I2C-to-SPI switch, the
+//!   configuration upload, data registers and sensor time); not yet one of the [`EmulatedChip`]s.
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
 mod ak8963;
+pub mod bmi270;
 mod emulated;
 pub mod icm42688p;
 pub mod mpu6xxx;

@@ -1,0 +1,139 @@
+//! Register-file semantics (DS: register description): what a read returns and changes, what a
+//! write stores and triggers.
+//!
+//! As for the other chips a bus read is split in two so the SPI target can prefetch one byte
+//! ahead: [`Bmi270::read_register`] returns the value (and holds SENSORTIME when SENSORTIME_0
+//! is read); [`Bmi270::commit_read`] applies what clocking the byte out does: clearing STATUS
+//! drdy_acc / drdy_gyr on a data read and EVENT on its read.
+//!
+//! - CMD 0xB6: soft reset, every register to its power-on value and the interface back to I2C;
+//!   the write log is kept. Other commands are ignored.
+//! - Read-only and reserved registers ignore writes; listed registers keep the bits outside
+//!   their fields at 0 ([`write_mask`]); CMD reads 0.
+
+use margemu_protocol::regmap::bmi270::convert::{sensortime, sensortime_bytes};
+use margemu_protocol::regmap::bmi270::{bits, reg, reset_value, write_mask, I2C_ADDRESS};
+
+use super::super::{Bus, RegisterWrite};
+use super::upload::Upload;
+use super::Bmi270;
+
+impl Bmi270 {
+    /// Soft reset (and power-on): registers to their reset values, upload and latches cleared,
+    /// the interface back to I2C mode.
+    pub(super) fn soft_reset(&mut self) {
+        for (addr, value) in (0u8..).zip(self.regs.iter_mut()) {
+            *value = reset_value(addr);
+        }
+        self.pending = None;
+        self.upload = Upload::default();
+        self.sensortime_hold = None;
+        self.spi_mode = false;
+    }
+
+    /// What a read of `addr` returns now, without side effects.
+    pub(super) fn value_of(&self, addr: u8) -> u8 {
+        match addr {
+            reg::SENSORTIME_0..=reg::SENSORTIME_2 => {
+                let ticks = self.sensortime_hold.unwrap_or(sensortime(self.now_ns));
+                let bytes = sensortime_bytes(ticks);
+                bytes
+                    .get(usize::from(addr - reg::SENSORTIME_0))
+                    .copied()
+                    .unwrap_or(0)
+            }
+            reg::CMD | reg::INIT_DATA => 0,
+            _ => self.stored(addr),
+        }
+    }
+
+    /// The value a bus read of `addr` clocks out; a read of SENSORTIME_0 holds the time.
+    pub(super) fn read_register(&mut self, addr: u8) -> u8 {
+        if addr == reg::SENSORTIME_0 {
+            self.sensortime_hold = Some(sensortime(self.now_ns));
+        }
+        self.value_of(addr)
+    }
+
+    /// `addr` was read: its side effects apply.
+    pub(super) fn commit_read(&mut self, addr: u8, _value: u8) {
+        let clear = match addr {
+            0x0C..=0x11 => bits::DRDY_ACC,
+            0x12..=0x17 => bits::DRDY_GYR,
+            reg::EVENT => {
+                self.set(reg::EVENT, 0);
+                return;
+            }
+            _ => return,
+        };
+        let status = self.stored(reg::STATUS) & !clear;
+        self.set(reg::STATUS, status);
+    }
+
+    /// A byte written to `addr` over `bus`.
+    pub(super) fn write_register(&mut self, bus: Bus, addr: u8, value: u8) {
+        if addr == reg::INIT_DATA {
+            let init_ctrl = self.stored(reg::INIT_CTRL);
+            let word = self.init_word_address();
+            self.upload.store(word, init_ctrl);
+            return;
+        }
+        self.log.push(RegisterWrite {
+            bus,
+            device: I2C_ADDRESS,
+            register: addr,
+            value,
+        });
+        match addr {
+            reg::CMD => {
+                if value == bits::CMD_SOFT_RESET {
+                    self.soft_reset();
+                    self.reset_in_transaction = true;
+                }
+            }
+            reg::INIT_CTRL => {
+                let old = self.stored(reg::INIT_CTRL);
+                self.set(reg::INIT_CTRL, value);
+                self.init_ctrl_written(old, value);
+            }
+            _ => {
+                let mask = write_mask(addr);
+                let stored = (self.stored(addr) & !mask) | (value & mask);
+                self.set(addr, stored);
+            }
+        }
+    }
+
+    /// The upload's word address, INIT_ADDR_1 << 4 | INIT_ADDR_0 bits 3:0.
+    fn init_word_address(&self) -> u16 {
+        u16::from(self.stored(reg::INIT_ADDR_1)) << 4
+            | u16::from(self.stored(reg::INIT_ADDR_0) & 0x0F)
+    }
+
+    /// INIT_CTRL 0 begins a load; 0 → 1 ends it and reports in INTERNAL_STATUS.
+    fn init_ctrl_written(&mut self, old: u8, new: u8) {
+        let message = if new == 0 {
+            self.upload = Upload::default();
+            bits::MSG_NOT_INIT
+        } else if old & 1 == 0 && new & 1 == 1 {
+            if self.upload.is_complete() {
+                bits::MSG_INIT_OK
+            } else {
+                bits::MSG_INIT_ERR
+            }
+        } else {
+            return;
+        };
+        let status = (self.stored(reg::INTERNAL_STATUS) & !bits::MSG_MASK) | message;
+        self.set(reg::INTERNAL_STATUS, status);
+    }
+
+    /// The transaction ended: bursts end, held values are released, a waiting sample appears.
+    pub(super) fn bus_went_idle(&mut self) {
+        self.upload.end_burst();
+        self.sensortime_hold = None;
+        if let Some((latch, drdy)) = self.pending.take() {
+            self.show(&latch, drdy);
+        }
+    }
+}
