@@ -10,15 +10,16 @@ use margemu_firmware::chip::PhysicalSample;
 
 const G: f32 = 9.80665;
 
-/// Writes `value` and reads it back, as ArduPilot's `write_register` check does (up to 8 tries).
-fn write_verified(c: &mut Bmi270, addr: u8, value: u8) {
+/// Writes `value` and reads it back, as ArduPilot's `write_register` does (up to 8 tries);
+/// whether it read back.
+fn write_verified(c: &mut Bmi270, addr: u8, value: u8) -> bool {
     for _ in 0..8 {
         spi_write(c, addr, &[value]);
         if read1(c, addr) == value {
-            return;
+            return true;
         }
     }
-    panic!("register {addr:#04x} never read back {value:#04x}");
+    false
 }
 
 /// Dummy read, CHIP_ID check, soft reset, dummy read again.
@@ -31,12 +32,23 @@ fn probe_and_reset(c: &mut Bmi270) {
     assert_eq!(read1(c, 0x00), 0x24, "CHIP_ID after reset");
 }
 
-/// ArduPilot: upload and check init_ok after 20 ms, up to 5 tries.
+/// ArduPilot's `hardware_init`: dummy read, soft reset through the read-back write (CMD reads 0,
+/// so it is sent 8 times, each time resetting the chip), dummy read, CHIP_ID, PWR_CONF 0,
+/// upload, INIT_CTRL 1, init_ok after 20 ms; up to 5 tries.
 fn ardupilot_init(c: &mut Bmi270, file: &[u8]) -> bool {
     for _ in 0..5 {
+        dummy_read(c);
+        c.advance(c.now_ns() + MS);
+        assert!(!write_verified(c, 0x7E, 0xB6), "CMD never reads back");
+        c.advance(c.now_ns() + 5 * MS);
+        dummy_read(c);
+        c.advance(c.now_ns() + MS);
+        if read1(c, 0x00) != 0x24 {
+            continue;
+        }
         upload(c, file);
         c.advance(c.now_ns() + 20 * MS);
-        if read1(c, 0x21) & 0x0F == 0x01 {
+        if read1(c, 0x21) & 1 == 1 {
             return true;
         }
     }
@@ -53,28 +65,28 @@ fn twelve_bytes(c: &mut Bmi270) -> Vec<i16> {
 #[test]
 fn ardupilot_sequence() {
     let mut c = chip();
-    probe_and_reset(&mut c);
     assert!(ardupilot_init(&mut c, &config_file(328)));
     for (addr, value) in [
-        (0x40, 0xAC), // ACC_CONF: 1.6 kHz, normal bandwidth, performance
+        (0x40, 0x8C), // ACC_CONF: 1.6 kHz, performance, OSR4
         (0x41, 0x03), // ACC_RANGE: ±16 g
-        (0x42, 0xEC), // GYR_CONF: 1.6 kHz, noise and filter performance
-        (0x43, 0x00), // GYR_RANGE: ±2000 °/s
-        (0x48, 0x00), // FIFO_CONFIG_0
-        (0x49, 0xD0), // FIFO_CONFIG_1: accel, gyro, headers
-        (0x7D, 0x0E), // PWR_CTRL: accel, gyro, temperature
+        (0x42, 0xED), // GYR_CONF: 3.2 kHz, noise and filter performance, normal
+        (0x43, 0x08), // GYR_RANGE: ±2000 °/s with the OIS range bit
+        (0x48, 0x01), // FIFO_CONFIG_0: stop on full, no sensor time frame
+        (0x49, 0xD0), // FIFO_CONFIG_1: gyro, accel, headers
+        (0x45, 0x89), // FIFO_DOWNS: filtered data, gyro downsampled by 2
         (0x7C, 0x02), // PWR_CONF: fifo_self_wakeup, no advanced power save
+        (0x7D, 0x0E), // PWR_CTRL: accel, gyro, temperature
     ] {
-        write_verified(&mut c, addr, value);
+        assert!(write_verified(&mut c, addr, value), "{addr:#04x}");
     }
-    assert_eq!(c.sample_period_ns(), Some(625_000));
+    assert_eq!(c.sample_period_ns(), Some(312_500));
     let s = PhysicalSample {
         acc: [0.0, 0.0, -G],
         gyr: [0.1, -0.2, 0.3],
         temp_c: 40.0,
         ..Default::default()
     };
-    c.latch_at(&s, c.now_ns() + 625_000);
+    c.latch_at(&s, c.now_ns() + 312_500);
     let data = twelve_bytes(&mut c);
     assert_eq!(data[..3], [0, 0, -2048]);
     for (raw, w) in data[3..].iter().zip(s.gyr) {
@@ -82,13 +94,13 @@ fn ardupilot_sequence() {
         assert!((f64::from(*raw) - want).abs() <= 1.0, "{raw} vs {want}");
     }
     let t = read(&mut c, 0x22, 2);
+    assert_ne!(t, [0x00, 0x80], "temperature valid");
     assert_eq!(i16::from_le_bytes([t[0], t[1]]), 17 * 512);
 }
 
 #[test]
 fn ardupilot_gives_up_on_a_truncated_file() {
     let mut c = chip();
-    probe_and_reset(&mut c);
     assert!(!ardupilot_init(&mut c, &config_file(200)));
     assert_eq!(read1(&mut c, 0x21), 0x02);
 }
