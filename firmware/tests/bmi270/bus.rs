@@ -32,6 +32,7 @@ fn power_on_values() {
     for addr in 0..0x80u8 {
         let expected = match addr {
             0x7E | 0x5E => 0,
+            0x26 => 0x80, // empty FIFO
             _ => reset_value(addr),
         };
         assert_eq!(c.peek(addr), expected, "register {addr:#04x}");

@@ -11,6 +11,7 @@
 mod bus;
 mod data;
 mod drivers;
+mod fifo;
 mod upload;
 
 #[path = "../common/transactions.rs"]

@@ -35,7 +35,12 @@
 //! (0x18..=0x1A) counts the chip's time (moved by latches and [`Bmi270::advance`]) at 39.0625 µs
 //! per LSB; reading SENSORTIME_0 holds the value for the rest of the burst.
 //!
-//! **Not emulated yet**: the FIFO (FIFO_LENGTH reads 0), ERR_REG, interrupts and the INT pins,
+//! **FIFO** (2 KB): headered (0x8C + gyro + accel) or headerless frames pushed
+//! at each latch, FIFO_LENGTH_0/1 in bytes, FIFO_DATA popped as it is clocked out, ERR_REG
+//! fifo_err on a stream-mode overflow, CMD 0xB0 flush.
+//!
+//! **Not emulated yet**: the FIFO's special frames (sensor time, skip, configuration change),
+//! FIFO_DOWNS and the watermark, the other ERR_REG bits, interrupts and the INT pins,
 //! the features of the configuration file (FEATURES pages are plain storage), the time the
 //! initialization takes (INTERNAL_STATUS changes at once), the 450 µs write spacing of the
 //! low-power mode (PWR_CONF adv_power_save is stored only), the I2C target, the auxiliary
@@ -68,6 +73,7 @@
 //! assert_eq!(spi(&mut chip, &[0x80 | 0x10, 0, 0, 0])[2..], [0x00, 0x10]); // ACC_Z: 4096 (±8 g)
 //! ```
 
+mod fifo;
 mod registers;
 mod sample;
 mod spi;
@@ -80,6 +86,7 @@ pub use margemu_protocol::regmap::bmi270::CONFIG_FILE_LENS;
 use super::spi_phase::SpiPhase;
 use super::write_log::{RegisterWrite, WriteLog};
 use super::PhysicalSample;
+use fifo::Fifo;
 use spi::Dummy;
 use upload::Upload;
 
@@ -103,6 +110,7 @@ pub struct Bmi270 {
     /// SENSORTIME held by a read of SENSORTIME_0 until the transaction ends.
     sensortime_hold: Option<u32>,
     upload: Upload,
+    fifo: Fifo,
     now_ns: u64,
     spi: SpiPhase,
     log: WriteLog<WRITE_LOG_LEN>,
@@ -125,6 +133,7 @@ impl Bmi270 {
             dummy: Dummy::None,
             sensortime_hold: None,
             upload: Upload::default(),
+            fifo: Fifo::default(),
             now_ns: 0,
             spi: SpiPhase::Idle,
             log: WriteLog::new(),

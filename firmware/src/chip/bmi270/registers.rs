@@ -4,10 +4,10 @@
 //! As for the other chips a bus read is split in two so the SPI target can prefetch one byte
 //! ahead: [`Bmi270::read_register`] returns the value (and holds SENSORTIME when SENSORTIME_0
 //! is read); [`Bmi270::commit_read`] applies what clocking the byte out does: clearing STATUS
-//! drdy_acc / drdy_gyr on a data read and EVENT on its read.
+//! drdy_acc / drdy_gyr on a data read, EVENT on its read, popping a FIFO_DATA byte.
 //!
 //! - CMD 0xB6: soft reset, every register to its power-on value and the interface back to I2C;
-//!   the write log is kept. Other commands are ignored.
+//!   the write log is kept. CMD 0xB0: FIFO flush. Other commands are ignored.
 //! - Read-only and reserved registers ignore writes; listed registers keep the bits outside
 //!   their fields at 0 ([`write_mask`]); CMD reads 0.
 
@@ -27,6 +27,7 @@ impl Bmi270 {
         }
         self.pending = None;
         self.upload = Upload::default();
+        self.fifo.flush();
         self.sensortime_hold = None;
         self.spi_mode = false;
     }
@@ -42,6 +43,8 @@ impl Bmi270 {
                     .copied()
                     .unwrap_or(0)
             }
+            reg::FIFO_LENGTH_0 | reg::FIFO_LENGTH_1 => self.fifo_length_byte(addr),
+            reg::FIFO_DATA => self.fifo.peek().unwrap_or(bits::FIFO_EMPTY),
             reg::CMD | reg::INIT_DATA => 0,
             _ => self.stored(addr),
         }
@@ -60,6 +63,10 @@ impl Bmi270 {
         let clear = match addr {
             0x0C..=0x11 => bits::DRDY_ACC,
             0x12..=0x17 => bits::DRDY_GYR,
+            reg::FIFO_DATA => {
+                self.fifo.pop();
+                return;
+            }
             reg::EVENT => {
                 self.set(reg::EVENT, 0);
                 return;
@@ -89,6 +96,8 @@ impl Bmi270 {
                 if value == bits::CMD_SOFT_RESET {
                     self.soft_reset();
                     self.reset_in_transaction = true;
+                } else if value == bits::CMD_FIFO_FLUSH {
+                    self.fifo_flush();
                 }
             }
             reg::INIT_CTRL => {

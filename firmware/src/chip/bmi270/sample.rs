@@ -27,6 +27,7 @@ impl Bmi270 {
         if pwr & (bits::TEMP_EN | bits::ACC_EN | bits::GYR_EN) != 0 {
             put(&mut latch, DATA_LEN, [temp_to_raw(sample.temp_c)]);
         }
+        self.fifo_push_sample(&latch, drdy);
         if self.spi.is_active() {
             let waiting = self.pending.map_or(0, |(_, d)| d);
             self.pending = Some((latch, drdy | waiting));

@@ -45,6 +45,9 @@ pub const CONFIG_RAM_LEN: usize = 8192;
 /// maximum-FIFO file the flight firmwares upload and the 8 KB full file.
 pub const CONFIG_FILE_LENS: [usize; 2] = [328, CONFIG_RAM_LEN];
 
+/// FIFO size in bytes (DS: 4.7 FIFO, 2 KB).
+pub const FIFO_SIZE: usize = 2048;
+
 /// The data registers ACC_X_LSB..=GYR_Z_MSB: 12 bytes.
 pub const DATA_LEN: usize = 12;
 
@@ -154,4 +157,22 @@ pub mod bits {
     pub const CMD_SOFT_RESET: u8 = 0xB6;
     /// ERR_REG.fifo_err.
     pub const FIFO_ERR: u8 = 1 << 6;
+    /// CMD: FIFO flush.
+    pub const CMD_FIFO_FLUSH: u8 = 0xB0;
+    /// FIFO_CONFIG_0.fifo_stop_on_full.
+    pub const FIFO_STOP_ON_FULL: u8 = 1 << 0;
+    /// FIFO_CONFIG_1.fifo_header_en.
+    pub const FIFO_HEADER_EN: u8 = 1 << 4;
+    /// FIFO_CONFIG_1.fifo_acc_en.
+    pub const FIFO_ACC_EN: u8 = 1 << 6;
+    /// FIFO_CONFIG_1.fifo_gyr_en.
+    pub const FIFO_GYR_EN: u8 = 1 << 7;
+    /// Header of a regular frame; bit 3 gyro, bit 2 accel (bit 4 aux) tell what follows.
+    pub const FIFO_HEADER_REGULAR: u8 = 0x80;
+    /// Header bit: gyro data in the frame.
+    pub const FIFO_HEADER_GYR: u8 = 1 << 3;
+    /// Header bit: accel data in the frame.
+    pub const FIFO_HEADER_ACC: u8 = 1 << 2;
+    /// What a read of an empty FIFO returns (DS: 4.7 FIFO, over-read).
+    pub const FIFO_EMPTY: u8 = 0x80;
 }
