@@ -105,3 +105,16 @@ fn writes_are_logged_except_init_data() {
     assert_eq!((w.device, w.register, w.value), (0x68, 0x7D, 0x0E));
     assert_eq!(c.pop_write(), None);
 }
+
+#[test]
+fn a_bare_chip_select_toggle_selects_spi() {
+    // Betaflight's bmi270EnableSPI: CS low, CS high, no clocks.
+    let mut c = chip();
+    c.select();
+    c.deselect();
+    assert_eq!(read1(&mut c, 0x00), 0x24);
+    spi_write(&mut c, 0x7E, &[0xB6]);
+    c.select();
+    c.deselect();
+    assert_eq!(read1(&mut c, 0x00), 0x24);
+}

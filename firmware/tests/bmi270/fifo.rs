@@ -71,12 +71,26 @@ fn frames_follow_the_enabled_sensors() {
 }
 
 #[test]
-fn a_partial_read_leaves_the_rest() {
+fn a_partially_read_frame_is_read_again_whole() {
     let mut c = fifo_chip(0x01, 0xD0);
     latch_numbered(&mut c, 1);
+    latch_numbered(&mut c, 2);
     assert_eq!(read(&mut c, 0x26, 1), [0x8C]);
-    assert_eq!(fifo_length(&mut c), 12);
-    assert_eq!(read(&mut c, 0x26, 2), [164, 0]);
+    assert_eq!(fifo_length(&mut c), 26);
+    assert_eq!(read(&mut c, 0x26, 3), [0x8C, 164, 0]);
+    assert_eq!(read(&mut c, 0x26, 14)[13], 0x8C); // frame 1 whole, then frame 2 begins
+    assert_eq!(fifo_length(&mut c), 13);
+    assert_eq!(read(&mut c, 0x26, 3), [0x8C, 72, 1]); // 328
+}
+
+#[test]
+fn betaflight_burst_from_fifo_length_into_fifo_data() {
+    let mut c = fifo_chip(0x00, 0x80); // gyro only, headerless (6.4 kHz mode)
+    latch_numbered(&mut c, 1);
+    latch_numbered(&mut c, 2);
+    // FIFO_LENGTH_0, FIFO_LENGTH_1, then FIFO_DATA (the burst stays on the port).
+    assert_eq!(read(&mut c, 0x24, 8), [12, 0, 164, 0, 0, 0, 0, 0]);
+    assert_eq!(fifo_length(&mut c), 6);
 }
 
 #[test]

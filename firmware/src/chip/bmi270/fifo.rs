@@ -10,20 +10,31 @@
 //!
 //! Not emulated: the sensor time frame after the last frame (FIFO_CONFIG_0 bit 1), skip,
 //! configuration-change and drop frames, FIFO_DOWNS and different accel and gyro rates (each
-//! latch is one frame), the auxiliary sensor, the watermark and its interrupt, re-reading a
-//! partially read frame (bytes leave the FIFO as they are clocked out), and stream mode
-//! discarding the oldest frames.
+//! latch is one frame), the auxiliary sensor, the watermark and its interrupt, and stream mode
+//! discarding the oldest frames. A frame leaves the FIFO only when all its bytes were clocked
+//! out in one burst; a burst that ends inside a frame leaves it to be read again whole.
 
 use margemu_protocol::regmap::bmi270::{bits, reg, FIFO_SIZE};
 
 use super::{Bmi270, LATCH_LEN};
 
-/// A ring buffer of FIFO bytes.
+/// Most frames the FIFO can hold (the shortest frame is 6 bytes).
+const MAX_FRAMES: usize = FIFO_SIZE / 6 + 1;
+
+/// A ring buffer of FIFO bytes, kept as whole frames: a frame leaves only once every byte of it
+/// was clocked out within one burst (DS: 4.7 FIFO; Betaflight's driver relies on a partially
+/// read frame staying in the queue).
 #[derive(Clone, Debug)]
 pub(super) struct Fifo {
     buf: [u8; FIFO_SIZE],
     head: usize,
     len: usize,
+    /// Lengths of the queued frames, oldest at `frame_head`.
+    frames: [u8; MAX_FRAMES],
+    frame_head: usize,
+    frame_count: usize,
+    /// Bytes of the oldest frame clocked out in the current burst.
+    read_in_front: usize,
 }
 
 impl Default for Fifo {
@@ -32,38 +43,66 @@ impl Default for Fifo {
             buf: [0; FIFO_SIZE],
             head: 0,
             len: 0,
+            frames: [0; MAX_FRAMES],
+            frame_head: 0,
+            frame_count: 0,
+            read_in_front: 0,
         }
     }
 }
 
 impl Fifo {
     pub(super) fn flush(&mut self) {
-        self.head = 0;
-        self.len = 0;
+        *self = Self {
+            buf: self.buf,
+            ..Self::default()
+        };
     }
 
+    /// Bytes queued, the partially read front frame included.
     pub(super) fn len(&self) -> usize {
         self.len
     }
 
     /// The next byte out, without removing it.
     pub(super) fn peek(&self) -> Option<u8> {
-        if self.len == 0 {
+        if self.read_in_front >= self.len {
             return None;
         }
-        self.buf.get(self.head).copied()
+        self.buf
+            .get((self.head + self.read_in_front) % FIFO_SIZE)
+            .copied()
     }
 
+    /// One byte was clocked out; the front frame leaves when its last byte has.
     pub(super) fn pop(&mut self) {
-        if self.len > 0 {
-            self.head = (self.head + 1) % FIFO_SIZE;
-            self.len -= 1;
+        if self.peek().is_none() {
+            return;
         }
+        self.read_in_front += 1;
+        let front = usize::from(self.frames.get(self.frame_head).copied().unwrap_or(0));
+        if self.read_in_front >= front {
+            let n = front.min(self.len);
+            self.head = (self.head + n) % FIFO_SIZE;
+            self.len -= n;
+            self.frame_head = (self.frame_head + 1) % MAX_FRAMES;
+            self.frame_count = self.frame_count.saturating_sub(1);
+            self.read_in_front = 0;
+        }
+    }
+
+    /// The burst ended: a partially read frame will be read again from its start.
+    pub(super) fn end_burst(&mut self) {
+        self.read_in_front = 0;
     }
 
     /// Appends `frame` whole; false (and nothing written) when it does not fit.
     pub(super) fn push(&mut self, frame: &[u8]) -> bool {
-        if frame.len() > FIFO_SIZE - self.len {
+        let Ok(frame_len) = u8::try_from(frame.len()) else {
+            return false;
+        };
+        if frame.is_empty() || frame.len() > FIFO_SIZE - self.len || self.frame_count >= MAX_FRAMES
+        {
             return false;
         }
         for &byte in frame {
@@ -73,6 +112,11 @@ impl Fifo {
             }
             self.len += 1;
         }
+        let slot = (self.frame_head + self.frame_count) % MAX_FRAMES;
+        if let Some(entry) = self.frames.get_mut(slot) {
+            *entry = frame_len;
+        }
+        self.frame_count += 1;
         true
     }
 }
@@ -153,9 +197,26 @@ mod tests {
         assert!(!f.push(&[0x8C; 13]));
         assert!(f.push(&[1; FIFO_SIZE % 13]));
         assert_eq!(f.len(), FIFO_SIZE);
-        f.pop();
-        assert_eq!(f.peek(), Some(0x8C));
         f.flush();
         assert_eq!(f.peek(), None);
+        assert!(!f.push(&[]));
+    }
+
+    #[test]
+    fn a_partially_read_frame_stays() {
+        let mut f = Fifo::default();
+        assert!(f.push(&[1, 2, 3, 4, 5, 6, 7]));
+        assert!(f.push(&[8; 7]));
+        f.pop();
+        f.pop();
+        assert_eq!((f.peek(), f.len()), (Some(3), 14));
+        f.end_burst();
+        assert_eq!(f.peek(), Some(1));
+        for _ in 0..7 {
+            f.pop();
+        }
+        assert_eq!((f.peek(), f.len()), (Some(8), 7));
+        f.end_burst();
+        assert_eq!(f.peek(), Some(8));
     }
 }

@@ -36,7 +36,7 @@
 //! per LSB; reading SENSORTIME_0 holds the value for the rest of the burst.
 //!
 //! **FIFO** (2 KB): headered (0x8C + gyro + accel) or headerless frames pushed
-//! at each latch, FIFO_LENGTH_0/1 in bytes, FIFO_DATA popped as it is clocked out, ERR_REG
+//! at each latch, FIFO_LENGTH_0/1 in bytes, FIFO_DATA (a frame leaves once read whole), ERR_REG
 //! fifo_err on a stream-mode overflow, CMD 0xB0 flush.
 //!
 //! **Not emulated yet**: the FIFO's special frames (sensor time, skip, configuration change),

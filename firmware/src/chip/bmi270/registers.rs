@@ -140,6 +140,7 @@ impl Bmi270 {
     /// The transaction ended: bursts end, held values are released, a waiting sample appears.
     pub(super) fn bus_went_idle(&mut self) {
         self.upload.end_burst();
+        self.fifo.end_burst();
         self.sensortime_hold = None;
         if let Some((latch, drdy)) = self.pending.take() {
             self.show(&latch, drdy);
