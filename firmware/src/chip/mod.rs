@@ -27,7 +27,8 @@
 //! - [`Icm42688p`]: the TDK InvenSense ICM-42688-P (banks 0–4, 2 KB FIFO with 16- and 20-bit
 //!   packets, INT1/INT2);
 //! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer, as an [`I2cTarget`] (not yet an
-//!   [`EmulatedChip`]).
+//!   [`EmulatedChip`]);
+//! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer, likewise an [`I2cTarget`] only.
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
@@ -36,6 +37,7 @@ mod emulated;
 pub mod icm42688p;
 pub mod ist8310;
 pub mod mpu6xxx;
+pub mod qmc5883l;
 mod spi_phase;
 mod write_log;
 
@@ -44,6 +46,7 @@ pub use emulated::{spi_read_burst_on_copy, Chip, EmulatedChip};
 pub use icm42688p::Icm42688p;
 pub use ist8310::Ist8310;
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
+pub use qmc5883l::Qmc5883l;
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 
 /// The SPI target side of a chip (mode 0/3, MSB first), byte by byte.
