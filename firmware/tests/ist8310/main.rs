@@ -7,6 +7,7 @@
 
 mod fc_ardupilot;
 mod fc_px4;
+mod random_sequences;
 
 #[path = "../common/transactions.rs"]
 mod transactions;

@@ -5,6 +5,7 @@
 #![allow(missing_docs)]
 
 mod fc_ardupilot;
+mod random_sequences;
 
 #[path = "../common/transactions.rs"]
 mod transactions;
