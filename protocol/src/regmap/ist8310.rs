@@ -10,6 +10,10 @@
 //! reads 7 bytes from STAT1 and requires STAT1.DRDY, waits at least 6 ms for a measurement with
 //! 16 times averaging, re-reads its configured registers). Nothing is copied from them.
 //!
+//! The datasheet PDF was not at hand when this module was written: the DS facts above are as
+//! the drivers and PX4's register header (which quotes DS field descriptions) give them, to be
+//! checked against the PDF.
+//!
 //! Not from the datasheet (stated where used): the reset values of AVGCNTL and PDCNTL and the
 //! measurement time for averaging other than 16 times.
 //!

@@ -11,6 +11,10 @@
 //! 6 data bytes only if bit 2 is set) and the Rust `qmc5883l` crate (register and bit names).
 //! Nothing is copied from them.
 //!
+//! The datasheet PDF was not at hand when this module was written: the DS facts above are as
+//! recalled and as driver headers (the Rust `qmc5883l` crate and other open-source QMC5883L
+//! drivers) name them (STATUS bit 0 DRDY, bit 1 OVL, bit 2 DOR), to be checked against the PDF.
+//!
 //! Not from the datasheet (stated where used): where the output clips (full scale, ±24000 LSB
 //! in both ranges) and when the first continuous measurement completes.
 //!
