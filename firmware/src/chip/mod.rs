@@ -25,21 +25,28 @@
 //!   mode, the MPU-6500, the MPU-6000 and the ICM-20602);
 //! - [`Ak8963`] on its own, as an [`I2cTarget`];
 //! - [`Icm42688p`]: the TDK InvenSense ICM-42688-P (banks 0–4, 2 KB FIFO with 16- and 20-bit
-//!   packets, INT1/INT2).
+//!   packets, INT1/INT2);
+//! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer, as an [`I2cTarget`] (not yet an
+//!   [`EmulatedChip`]);
+//! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer, likewise an [`I2cTarget`] only.
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
 mod ak8963;
 mod emulated;
 pub mod icm42688p;
+pub mod ist8310;
 pub mod mpu6xxx;
+pub mod qmc5883l;
 mod spi_phase;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
 pub use emulated::{spi_read_burst_on_copy, Chip, EmulatedChip};
 pub use icm42688p::Icm42688p;
+pub use ist8310::Ist8310;
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
+pub use qmc5883l::Qmc5883l;
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 
 /// The SPI target side of a chip (mode 0/3, MSB first), byte by byte.

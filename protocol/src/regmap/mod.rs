@@ -8,7 +8,9 @@
 //!   ([`mpu6xxx::image`]);
 //! - [`ak8963`]: the same for the AK8963 magnetometer die behind the MPU-9250's auxiliary bus;
 //! - [`icm42688p`]: the TDK InvenSense ICM-42688-P: banks 0–4, full scales, output rates, FIFO
-//!   packet sizes, conversions (16- and 20-bit) and its 32-byte register image.
+//!   packet sizes, conversions (16- and 20-bit) and its 32-byte register image;
+//! - [`ist8310`]: the iSentek IST8310 standalone I2C magnetometer;
+//! - [`qmc5883l`]: the QST QMC5883L standalone I2C magnetometer.
 //!
 //! Both the firmware (which serves these values) and the host (which predicts what a driver
 //! reads) call the same functions, so they agree bit for bit.
@@ -21,6 +23,8 @@
 
 pub mod ak8963;
 pub mod icm42688p;
+pub mod ist8310;
 pub mod mpu6xxx;
+pub mod qmc5883l;
 
 pub use mpu6xxx::image::IMAGE_LEN;
