@@ -28,6 +28,9 @@
 //!   packets, INT1/INT2);
 //! - [`bmi270::Bmi270`]: the Bosch BMI270 (SPI with its dummy byte and I2C-to-SPI switch, the
 //!   configuration upload, data registers and sensor time); not yet one of the [`EmulatedChip`]s.
+//! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer, as an [`I2cTarget`] (not yet an
+//!   [`EmulatedChip`]);
+//! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer, likewise an [`I2cTarget`] only.
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
@@ -35,14 +38,18 @@ mod ak8963;
 pub mod bmi270;
 mod emulated;
 pub mod icm42688p;
+pub mod ist8310;
 pub mod mpu6xxx;
+pub mod qmc5883l;
 mod spi_phase;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
 pub use emulated::{spi_read_burst_on_copy, Chip, EmulatedChip};
 pub use icm42688p::Icm42688p;
+pub use ist8310::Ist8310;
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
+pub use qmc5883l::Qmc5883l;
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 
 /// The SPI target side of a chip (mode 0/3, MSB first), byte by byte.

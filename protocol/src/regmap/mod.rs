@@ -11,7 +11,9 @@
 //!   packet sizes, conversions (16- and 20-bit) and its 32-byte register image;
 //! - [`bmi270`]: the Bosch BMI270: register map, access masks, ranges, output rates, the
 //!   configuration upload's registers and the conversions (little-endian data, temperature,
-//!   sensor time).
+//!   sensor time);
+//! - [`ist8310`]: the iSentek IST8310 standalone I2C magnetometer;
+//! - [`qmc5883l`]: the QST QMC5883L standalone I2C magnetometer.
 //!
 //! Both the firmware (which serves these values) and the host (which predicts what a driver
 //! reads) call the same functions, so they agree bit for bit.
@@ -25,6 +27,8 @@
 pub mod ak8963;
 pub mod bmi270;
 pub mod icm42688p;
+pub mod ist8310;
 pub mod mpu6xxx;
+pub mod qmc5883l;
 
 pub use mpu6xxx::image::IMAGE_LEN;
