@@ -29,7 +29,7 @@
 #![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use margemu_firmware::chip::{Chip, EmulatedChip, Mpu6xxx, PhysicalSample, SpiTarget};
+use margemu_firmware::chip::{Chip, EmulatedChip, I2cTarget, Mpu6xxx, PhysicalSample, SpiTarget};
 use margemu_protocol::chip::{ChipModel, ChipSettings, Family};
 use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
 use std::hint::black_box;
@@ -142,22 +142,37 @@ fn spi_write(chip: &mut EmulatedChip, bytes: &[u8]) {
 }
 
 /// `model` at power-on with its sensors on (MPU family: PWR_MGMT_1 = 0x01, awake on the PLL;
-/// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise).
+/// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise; QMC5883L: CONF1 = 0x0D,
+/// continuous at 200 Hz; IST8310: single measurements, triggered by its reader).
 fn powered(model: ChipModel) -> EmulatedChip {
-    let mut chip = EmulatedChip::new(model, model.who_am_i(), 0x68).expect("the model's identity");
+    let address = model.i2c_addresses()[0];
+    let mut chip =
+        EmulatedChip::new(model, model.who_am_i(), address).expect("the model's identity");
     match model.family() {
         Family::Mpu6xxx => spi_write(&mut chip, &[0x6B, 0x01]),
         Family::Icm42688p => spi_write(&mut chip, &[0x4E, 0x0F]),
+        Family::Qmc5883l => assert!(chip.write_register(0, 0x09, 0x0D)),
+        Family::Ist8310 => {}
     }
     chip
 }
 
-/// The first register of the model's data burst.
-fn burst_start(model: ChipModel) -> u8 {
-    match model.family() {
-        Family::Mpu6xxx => 0x3B,   // ACCEL_XOUT_H
-        Family::Icm42688p => 0x1D, // TEMP_DATA1
+/// Times `iters` I2C reads of `n` bytes from register `start` (a pointer write, then a read).
+fn timed_i2c_bursts(chip: &mut EmulatedChip, start: u8, n: usize, iters: u64) -> Duration {
+    let address = chip.i2c_address();
+    let t = Instant::now();
+    for _ in 0..iters {
+        chip.start(address, false);
+        chip.write(black_box(start));
+        chip.start(address, true);
+        let mut acc = 0u8;
+        for _ in 0..n {
+            acc ^= chip.read();
+        }
+        chip.stop();
+        black_box(acc);
     }
+    t.elapsed()
 }
 
 /// Times `iters` reads of `mosi` (one transaction each).
@@ -222,12 +237,26 @@ fn per_chip(c: &mut Criterion) {
     }
     group.finish();
 
-    let mut group = c.benchmark_group("chip spi burst");
-    for model in EmulatedChip::models() {
+    let mut group = c.benchmark_group("chip i2c burst");
+    for model in EmulatedChip::models().filter(|m| m.is_magnetometer_only()) {
         let mut chip = powered(model);
         let period = chip.sample_period_ns();
         Chip::latch_at(&mut chip, &s, period);
-        let start = burst_start(model);
+        let start = chip.burst_start();
+        group.throughput(Throughput::Bytes(7));
+        group.bench_function(
+            BenchmarkId::new(format!("0x{start:02X} + 7 bytes"), model.name()),
+            |b| b.iter_custom(|iters| timed_i2c_bursts(&mut chip, start, 7, iters)),
+        );
+    }
+    group.finish();
+
+    let mut group = c.benchmark_group("chip spi burst");
+    for model in EmulatedChip::models().filter(|m| !m.is_magnetometer_only()) {
+        let mut chip = powered(model);
+        let period = chip.sample_period_ns();
+        Chip::latch_at(&mut chip, &s, period);
+        let start = chip.burst_start();
         let mut mosi = [0u8; 15];
         mosi[0] = 0x80 | start;
         group.throughput(Throughput::Bytes(mosi.len() as u64));

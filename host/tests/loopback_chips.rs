@@ -37,9 +37,13 @@ fn meta(dir: &Path) -> toml::Table {
 }
 
 fn check_chip_fixture(file: &str, model: &str, samples: usize, image_len: i64) {
+    check_chip_scene(&fixture(file), model, samples, image_len);
+}
+
+fn check_chip_scene(scene: &Path, model: &str, samples: usize, image_len: i64) {
     for source in ["images", "model"] {
         let tag = format!("{model}-{source}");
-        let (out, dir) = loopback(&fixture(file), &tag, &["--source", source]);
+        let (out, dir) = loopback(scene, &tag, &["--source", source]);
         let confirmed = format!("{samples} of {samples} predicted images confirmed byte for byte");
         assert!(out.contains(&confirmed), "{tag}: {out}");
         assert!(out.contains("(0 underruns, 0 overruns)"), "{tag}: {out}");
@@ -58,6 +62,30 @@ fn icm42688p_fixture_is_served_as_predicted_in_both_source_modes() {
 #[test]
 fn mpu6000_fixture_is_served_as_predicted_in_both_source_modes() {
     check_chip_fixture("mpu6000.toml", "mpu6000", 1000, 14);
+}
+
+/// A standalone magnetometer as the scene's only chip: its 6-byte images (at the scene's range)
+/// are served as predicted in both source modes, whatever rate the scene runs at.
+#[test]
+fn magnetometers_alone_are_served_as_predicted_in_both_source_modes() {
+    let dir = std::env::temp_dir().join(format!("margemu-mag-scenes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (model, chip_table) in [
+        (
+            "ist8310",
+            "model = \"ist8310\"\nbus = \"i2c\"\naddress = 0x0C\n",
+        ),
+        ("qmc5883l", "model = \"qmc5883l\"\nmag_range = 8\n"),
+    ] {
+        let scene = dir.join(format!("{model}.toml"));
+        let text = format!(
+            "duration = 1.0\nrate = 250.0\nseed = 31\nmotion = \"kinematic\"\n\n[chip]\n{chip_table}\n\
+             [joints.yaw]\ntype = \"sine\"\namplitude = 1.5\nfrequency = 1.0\n"
+        );
+        std::fs::write(&scene, text).unwrap();
+        check_chip_scene(&scene, model, 250, 6);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

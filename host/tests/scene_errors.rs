@@ -212,6 +212,47 @@ fn chip_table_errors_are_located() {
 }
 
 #[test]
+fn magnetometer_chip_errors_are_located() {
+    let chip = |body: &str| format!("{BASE}[chip]\n{body}");
+    assert_error(
+        &chip("model = \"ist8310\"\nbus = \"spi\"\n"),
+        "6:7",
+        "the IST8310 has no spi bus",
+    );
+    assert_error(
+        &chip("model = \"qmc5883l\"\naccel_range = 8\n"),
+        "6:15",
+        "the QMC5883L is a magnetometer: it has no accel_range",
+    );
+    assert_error(
+        &chip("model = \"qmc5883l\"\nmag_range = 4\n"),
+        "6:13",
+        "the QMC5883L has no ±4 G range; its ranges are ± 2, 8 G",
+    );
+    assert_error(
+        &chip("model = \"icm42688p\"\nmag_range = 8\n"),
+        "6:13",
+        "the ICM-42688-P has no magnetometer range to choose",
+    );
+    assert_error(
+        &chip("model = \"ist8310\"\naddress = 0x1E\n"),
+        "6:11",
+        "the IST8310 answers I2C at 0x0e, 0x0c, 0x0d, 0x0f, not 0x1e",
+    );
+    let scene = Scene::parse_str(
+        &chip("model = \"qmc5883l\"\nmag_range = 8\n"),
+        Path::new("q.toml"),
+    )
+    .unwrap();
+    assert_eq!(
+        scene.chip.bus,
+        margemu::scene::chip::BusKind::I2c,
+        "its only bus"
+    );
+    assert_eq!(scene.chip.settings.mag_range_gauss(), Some(8.0));
+}
+
+#[test]
 fn chip_table_resolves_with_defaults() {
     use margemu_protocol::chip::ChipModel;
     let scene = Scene::parse_str(BASE, Path::new("plain.toml")).unwrap();
@@ -227,7 +268,7 @@ fn chip_table_resolves_with_defaults() {
         (chip.model, chip.who_am_i, chip.i2c_address),
         (ChipModel::Icm42688p, 0x47, 0x69)
     );
-    let fs = chip.settings.full_scale();
+    let fs = chip.settings.full_scale().expect("an IMU");
     assert_eq!((fs.accel_g, fs.gyro_dps), (4.0, 500.0));
     assert_eq!(chip.to_chip([1.0, 2.0, 3.0]), [2.0, 1.0, -3.0]);
 }

@@ -161,10 +161,15 @@ pub struct ChipMeta {
     pub i2c_address: u8,
     /// Bytes of one register image.
     pub image_len: usize,
-    /// Accelerometer full scale (g).
-    pub accel_range_g: f64,
-    /// Gyroscope full scale (°/s).
-    pub gyro_range_dps: f64,
+    /// Accelerometer full scale (g); absent for a magnetometer.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accel_range_g: Option<f64>,
+    /// Gyroscope full scale (°/s); absent for a magnetometer.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gyro_range_dps: Option<f64>,
+    /// Magnetometer range (gauss), for a magnetometer whose range a driver chooses.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mag_range_gauss: Option<f64>,
     /// The chip's mounting rotation, rows.
     pub rotation: Option<crate::scene::chip::Rotation>,
 }

@@ -61,7 +61,7 @@ fn icm_scene(rate_hz: u32, seed: u64) -> Scene {
     let scene =
         Scene::parse_str(&text, Path::new("qemu-icm42688p.toml")).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(scene.chip.model, ChipModel::Icm42688p);
-    let fs = scene.chip.settings.full_scale();
+    let fs = scene.chip.settings.full_scale().expect("an IMU");
     assert_eq!((fs.accel_g, fs.gyro_dps), (8.0, 1000.0));
     scene
 }

@@ -75,12 +75,29 @@ pub fn read_meta(dir: &Path) -> Result<SessionMeta, SessionFileError> {
         Some(c) => {
             let model = ChipModel::from_name(&c.model)
                 .ok_or_else(|| bad(&path, format!("[chip] model = {:?} is no chip", c.model)))?;
-            let fs = FullScale {
-                accel_g: c.accel_range_g,
-                gyro_dps: c.gyro_range_dps,
+            let settings = match (c.accel_range_g, c.gyro_range_dps) {
+                (Some(accel_g), Some(gyro_dps)) => {
+                    let fs = FullScale { accel_g, gyro_dps };
+                    ChipSettings::with_full_scale(model, fs)
+                        .map_err(|e| bad(&path, format!("[chip]: {e:?}")))?
+                }
+                (None, None) => ChipSettings::power_on(model),
+                _ => {
+                    let reason =
+                        "[chip] has one of accel_range_g and gyro_range_dps without the other";
+                    return Err(bad(&path, reason.to_string()));
+                }
             };
-            ChipSettings::with_full_scale(model, fs)
-                .map_err(|e| bad(&path, format!("[chip]: {e:?}")))?
+            match c.mag_range_gauss {
+                None => settings,
+                Some(gauss) => settings.with_mag_range(gauss).map_err(|_| {
+                    let reason = format!(
+                        "[chip] mag_range_gauss = {gauss} is no range of the {}",
+                        model.part_name()
+                    );
+                    bad(&path, reason)
+                })?,
+            }
         }
     };
     if let (Some(m), Conversion::Mpu6xxx(image)) =

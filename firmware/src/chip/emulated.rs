@@ -21,7 +21,7 @@ use margemu_protocol::chip::{ChipModel, ChipSettings, PhysicalSample};
 
 use super::icm42688p::{self, Icm42688p};
 use super::mpu6xxx::{self, Mpu6xxx, Variant};
-use super::{I2cTarget, RegisterWrite, SpiTarget};
+use super::{I2cTarget, Ist8310, Qmc5883l, RegisterWrite, SpiTarget};
 
 /// What every emulated chip does for the link, the boards and the host (see the module docs).
 /// Time is the scene time in ns, moved forward only by latches and [`Chip::advance`].
@@ -112,6 +112,10 @@ pub enum EmulatedChip {
     Mpu6xxx(Mpu6xxx),
     /// The TDK InvenSense ICM-42688-P.
     Icm42688p(Icm42688p),
+    /// The iSentek IST8310 magnetometer.
+    Ist8310(Ist8310),
+    /// The QST QMC5883L magnetometer.
+    Qmc5883l(Qmc5883l),
 }
 
 impl Default for EmulatedChip {
@@ -130,11 +134,18 @@ impl EmulatedChip {
             return None;
         }
         let ad0 = model.i2c_addresses().get(1) == Some(&i2c_address);
-        if model == ChipModel::Icm42688p {
-            return Some(Self::Icm42688p(Icm42688p::with_config(icm42688p::Config {
-                ad0,
-                who_am_i,
-            })));
+        match model {
+            ChipModel::Icm42688p => {
+                return Some(Self::Icm42688p(Icm42688p::with_config(icm42688p::Config {
+                    ad0,
+                    who_am_i,
+                })))
+            }
+            ChipModel::Ist8310 => return Some(Self::Ist8310(Ist8310::with_address(i2c_address))),
+            ChipModel::Qmc5883l => {
+                return Some(Self::Qmc5883l(Qmc5883l::with_address(i2c_address)))
+            }
+            _ => {}
         }
         let variant = Variant::for_model(model, who_am_i)?;
         Some(Self::Mpu6xxx(Mpu6xxx::with_config(mpu6xxx::Config {
@@ -147,7 +158,10 @@ impl EmulatedChip {
     /// The models this firmware emulates.
     pub fn models() -> impl Iterator<Item = ChipModel> {
         ChipModel::ALL.into_iter().filter(|m| {
-            *m == ChipModel::Icm42688p || Variant::for_model(*m, m.who_am_i()).is_some()
+            matches!(
+                m,
+                ChipModel::Icm42688p | ChipModel::Ist8310 | ChipModel::Qmc5883l
+            ) || Variant::for_model(*m, m.who_am_i()).is_some()
         })
     }
 }
@@ -158,6 +172,8 @@ macro_rules! each_chip {
         match $self {
             EmulatedChip::Mpu6xxx($chip) => $call,
             EmulatedChip::Icm42688p($chip) => $call,
+            EmulatedChip::Ist8310($chip) => $call,
+            EmulatedChip::Qmc5883l($chip) => $call,
         }
     };
 }
@@ -227,7 +243,7 @@ impl Chip for EmulatedChip {
         each_chip!(self, c => c.writes_dropped())
     }
     fn write_register(&mut self, file: u8, register: u8, value: u8) -> bool {
-        each_chip!(self, c => c.write_register(file, register, value))
+        each_chip!(self, c => Chip::write_register(c, file, register, value))
     }
     fn i2c_address(&self) -> u8 {
         each_chip!(self, c => Chip::i2c_address(c))
@@ -278,13 +294,17 @@ mod tests {
                 accel_g: 16.0,
                 gyro_dps: 2000.0,
             };
-            let want = ChipSettings::with_full_scale(model, fs).unwrap();
+            let want = match ChipSettings::mag_ranges_gauss(model).last() {
+                Some(&gauss) => ChipSettings::power_on(model).with_mag_range(gauss).unwrap(),
+                None if model.is_magnetometer_only() => ChipSettings::power_on(model),
+                None => ChipSettings::with_full_scale(model, fs).unwrap(),
+            };
             let mut chip =
                 EmulatedChip::new(model, model.who_am_i(), model.i2c_addresses()[0]).unwrap();
             for (file, register, value) in want.config_writes(1000.0) {
                 assert!(chip.write_register(file, register, value), "{model:?}");
             }
-            assert_eq!(chip.settings(), want, "{model:?} at ±16 g, ±2000 °/s");
+            assert_eq!(chip.settings(), want, "{model:?} at its largest ranges");
         }
     }
 }

@@ -35,7 +35,9 @@
 
 use margemu_protocol::regmap::ist8310::{self as map, bits, reg, reset, Mode};
 
-use super::I2cTarget;
+use super::magnetometer::{flag, Held, MAG_WRITE_LOG_LEN};
+use super::pointer_i2c::{PointerI2c, Step};
+use super::{Bus, I2cTarget, RegisterWrite, WriteLog};
 
 /// The IST8310.
 #[derive(Clone, Debug)]
@@ -53,9 +55,11 @@ pub struct Ist8310 {
     /// Completion time of the measurement in progress, if any.
     next_due: Option<u64>,
     now_ns: u64,
-    field_ut: [f32; 3],
+    held: Held,
     pointer: u8,
-    expect_register: bool,
+    address: u8,
+    bus: PointerI2c,
+    pub(super) log: WriteLog<MAG_WRITE_LOG_LEN>,
 }
 
 impl Default for Ist8310 {
@@ -80,10 +84,19 @@ impl Ist8310 {
             data: [0; 6],
             next_due: None,
             now_ns: 0,
-            field_ut: [0.0; 3],
+            held: Held::Field([0.0; 3]),
             pointer: 0,
-            expect_register: false,
+            address: map::I2C_ADDRESS,
+            bus: PointerI2c::new(),
+            log: WriteLog::new(),
         }
+    }
+
+    /// The chip strapped to 7-bit I2C `address` (the drivers' default: [`map::I2C_ADDRESS`]).
+    pub const fn with_address(address: u8) -> Self {
+        let mut chip = Self::new();
+        chip.address = address;
+        chip
     }
 
     /// Soft reset (CNTL2.SRST, the power-on routine): every register to its reset value. The
@@ -91,9 +104,11 @@ impl Ist8310 {
     pub fn reset(&mut self) {
         *self = Self {
             now_ns: self.now_ns,
-            field_ut: self.field_ut,
+            held: self.held,
             pointer: self.pointer,
-            expect_register: self.expect_register,
+            address: self.address,
+            bus: self.bus,
+            log: self.log.clone(),
             ..Self::new()
         };
     }
@@ -103,9 +118,19 @@ impl Ist8310 {
         Mode::from_cntl1(self.cntl1)
     }
 
-    /// The field (µT, chip axes) the chip senses until the next [`Ist8310::advance`].
-    pub fn held_field(&self) -> [f32; 3] {
-        self.field_ut
+    /// What the chip senses until the next [`Ist8310::advance`] or image latch.
+    pub fn held(&self) -> Held {
+        self.held
+    }
+
+    /// The chip's clock.
+    pub fn now_ns(&self) -> u64 {
+        self.now_ns
+    }
+
+    /// The chip's 7-bit I2C address.
+    pub fn address(&self) -> u8 {
+        self.address
     }
 
     /// The register value at `addr`, without side effects.
@@ -182,7 +207,13 @@ impl Ist8310 {
     /// Moves the chip's clock to `now_ns` (never backwards) with `field_ut` (µT, chip axes) as
     /// the field it senses from now on, and completes the measurement due by then, if any.
     pub fn advance(&mut self, now_ns: u64, field_ut: [f32; 3]) {
-        self.field_ut = field_ut;
+        self.sense_at(now_ns, Held::Field(field_ut));
+    }
+
+    /// Moves the chip's clock to `now_ns` (never backwards) sensing `held` from now on, and
+    /// completes what is due by then ([`Ist8310::advance`] with a field or raw values).
+    pub fn sense_at(&mut self, now_ns: u64, held: Held) {
+        self.held = held;
         self.now_ns = self.now_ns.max(now_ns);
         match self.next_due {
             Some(due) if due <= self.now_ns => {
@@ -206,43 +237,48 @@ impl Ist8310 {
     }
 
     fn measure(&mut self) {
-        let (raw, _clipped) = map::measurement(self.field_ut);
+        let raw = match self.held {
+            Held::Field(field_ut) => map::measurement(field_ut).0,
+            Held::Raw(raw) => raw,
+        };
         self.dor = self.drdy;
         self.drdy = true;
         self.data = map::data_bytes(raw);
     }
 }
 
-fn flag(set: bool, bit: u8) -> u8 {
-    if set {
-        bit
-    } else {
-        0
-    }
-}
-
 impl I2cTarget for Ist8310 {
     fn start(&mut self, address: u8, read: bool) -> bool {
-        self.expect_register = !read;
-        address == map::I2C_ADDRESS
+        self.bus.start(address == self.address, read)
     }
 
     fn write(&mut self, byte: u8) -> bool {
-        if self.expect_register {
-            self.expect_register = false;
-            self.pointer = byte;
-        } else {
-            self.write_next(byte);
+        match self.bus.write(byte) {
+            Step::Pointer(addr) => self.pointer = addr,
+            Step::Data(value) => {
+                let register = self.write_next(value);
+                self.log.push(RegisterWrite {
+                    bus: Bus::I2c,
+                    device: self.address,
+                    register,
+                    value,
+                });
+            }
+            Step::Ignored => return false,
         }
         true
     }
 
     fn read(&mut self) -> u8 {
-        self.read_next()
+        if self.bus.may_read() {
+            self.read_next()
+        } else {
+            0xFF
+        }
     }
 
     fn stop(&mut self) {
-        self.expect_register = false;
+        self.bus.stop();
     }
 }
 

@@ -28,9 +28,9 @@
 //!   packets, INT1/INT2);
 //! - [`bmi270::Bmi270`]: the Bosch BMI270 (SPI with its dummy byte and I2C-to-SPI switch, the
 //!   configuration upload, data registers and sensor time); not yet one of the [`EmulatedChip`]s.
-//! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer, as an [`I2cTarget`] (not yet an
-//!   [`EmulatedChip`]);
-//! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer, likewise an [`I2cTarget`] only.
+//! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer (I2C only);
+//! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer (I2C only); both share their
+//!   [`Chip`] boundary ([`magnetometer`]) and I2C front end ([`pointer_i2c`]).
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
@@ -39,7 +39,9 @@ pub mod bmi270;
 mod emulated;
 pub mod icm42688p;
 pub mod ist8310;
+pub mod magnetometer;
 pub mod mpu6xxx;
+pub mod pointer_i2c;
 pub mod qmc5883l;
 mod spi_phase;
 mod write_log;

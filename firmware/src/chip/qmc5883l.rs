@@ -32,9 +32,12 @@
 //! assert_eq!(data_and_status, [0xDC, 0x05, 0, 0, 0xE2, 0xFF, 0x00]);
 //! ```
 
+use margemu_protocol::regmap::mag_image;
 use margemu_protocol::regmap::qmc5883l::{self as map, bits, reg, Mode, Odr, Range};
 
-use super::I2cTarget;
+use super::magnetometer::{flag, Held, MAG_WRITE_LOG_LEN};
+use super::pointer_i2c::{PointerI2c, Step};
+use super::{Bus, I2cTarget, RegisterWrite, WriteLog};
 
 /// The QMC5883L.
 #[derive(Clone, Debug)]
@@ -50,9 +53,11 @@ pub struct Qmc5883l {
     /// Completion time of the next measurement in continuous mode.
     next_due: Option<u64>,
     now_ns: u64,
-    field_ut: [f32; 3],
+    held: Held,
     pointer: u8,
-    expect_register: bool,
+    address: u8,
+    bus: PointerI2c,
+    pub(super) log: WriteLog<MAG_WRITE_LOG_LEN>,
 }
 
 impl Default for Qmc5883l {
@@ -75,10 +80,19 @@ impl Qmc5883l {
             data: [0; 6],
             next_due: None,
             now_ns: 0,
-            field_ut: [0.0; 3],
+            held: Held::Field([0.0; 3]),
             pointer: 0,
-            expect_register: false,
+            address: map::I2C_ADDRESS,
+            bus: PointerI2c::new(),
+            log: WriteLog::new(),
         }
+    }
+
+    /// The chip strapped to 7-bit I2C `address` (the drivers' default: [`map::I2C_ADDRESS`]).
+    pub const fn with_address(address: u8) -> Self {
+        let mut chip = Self::new();
+        chip.address = address;
+        chip
     }
 
     /// Soft reset (CONF2.SOFT_RST): every register to its default. The clock, the held field and
@@ -86,9 +100,11 @@ impl Qmc5883l {
     pub fn reset(&mut self) {
         *self = Self {
             now_ns: self.now_ns,
-            field_ut: self.field_ut,
+            held: self.held,
             pointer: self.pointer,
-            expect_register: self.expect_register,
+            address: self.address,
+            bus: self.bus,
+            log: self.log.clone(),
             ..Self::new()
         };
     }
@@ -108,9 +124,19 @@ impl Qmc5883l {
         Range::from_conf1(self.conf1)
     }
 
-    /// The field (µT, chip axes) the chip senses until the next [`Qmc5883l::advance`].
-    pub fn held_field(&self) -> [f32; 3] {
-        self.field_ut
+    /// What the chip senses until the next [`Qmc5883l::advance`] or image latch.
+    pub fn held(&self) -> Held {
+        self.held
+    }
+
+    /// The chip's clock.
+    pub fn now_ns(&self) -> u64 {
+        self.now_ns
+    }
+
+    /// The chip's 7-bit I2C address.
+    pub fn address(&self) -> u8 {
+        self.address
     }
 
     /// The register value at `addr`, without side effects.
@@ -185,7 +211,13 @@ impl Qmc5883l {
     /// the field it senses from now on, and completes the measurements due by then (only the
     /// last one is visible; the others count as skipped).
     pub fn advance(&mut self, now_ns: u64, field_ut: [f32; 3]) {
-        self.field_ut = field_ut;
+        self.sense_at(now_ns, Held::Field(field_ut));
+    }
+
+    /// Moves the chip's clock to `now_ns` (never backwards) sensing `held` from now on, and
+    /// completes what is due by then ([`Qmc5883l::advance`] with a field or raw values).
+    pub fn sense_at(&mut self, now_ns: u64, held: Held) {
+        self.held = held;
         self.now_ns = self.now_ns.max(now_ns);
         let Some(due) = self.next_due else { return };
         if self.now_ns < due {
@@ -213,45 +245,49 @@ impl Qmc5883l {
 
     /// Stores one measurement (`skipped`: earlier ones were overwritten before anyone could read).
     fn measure(&mut self, skipped: bool) {
-        let (raw, overflow) = map::measurement(self.field_ut, self.range());
-        let [x, y, z] = raw.map(i16::to_le_bytes);
-        self.data = [x[0], x[1], y[0], y[1], z[0], z[1]];
+        let raw = match self.held {
+            Held::Field(field_ut) => map::measurement(field_ut, self.range()).0,
+            Held::Raw(raw) => raw,
+        };
+        self.data = mag_image::emit(raw);
         self.dor = self.drdy || skipped;
         self.drdy = true;
-        self.ovl = overflow;
-    }
-}
-
-fn flag(set: bool, bit: u8) -> u8 {
-    if set {
-        bit
-    } else {
-        0
+        self.ovl = map::overflows(raw);
     }
 }
 
 impl I2cTarget for Qmc5883l {
     fn start(&mut self, address: u8, read: bool) -> bool {
-        self.expect_register = !read;
-        address == map::I2C_ADDRESS
+        self.bus.start(address == self.address, read)
     }
 
     fn write(&mut self, byte: u8) -> bool {
-        if self.expect_register {
-            self.expect_register = false;
-            self.pointer = byte;
-        } else {
-            self.write_next(byte);
+        match self.bus.write(byte) {
+            Step::Pointer(addr) => self.pointer = addr,
+            Step::Data(value) => {
+                let register = self.write_next(value);
+                self.log.push(RegisterWrite {
+                    bus: Bus::I2c,
+                    device: self.address,
+                    register,
+                    value,
+                });
+            }
+            Step::Ignored => return false,
         }
         true
     }
 
     fn read(&mut self) -> u8 {
-        self.read_next()
+        if self.bus.may_read() {
+            self.read_next()
+        } else {
+            0xFF
+        }
     }
 
     fn stop(&mut self) {
-        self.expect_register = false;
+        self.bus.stop();
     }
 }
 

@@ -87,8 +87,8 @@ use margemu_protocol::PROTOCOL_VERSION;
 use crate::chip::{self, Chip, EmulatedChip};
 use setup::Model;
 
-/// The shortest image of any model (the 6xxx parts without magnetometer).
-const SMALLEST_IMAGE_LEN: usize = 14;
+/// The shortest image of any model (the standalone magnetometers).
+const SMALLEST_IMAGE_LEN: usize = margemu_protocol::regmap::mag_image::IMAGE_LEN;
 
 /// Telemetry period when Configure asks for the default (0): 100 ms.
 pub const DEFAULT_TELEMETRY_PERIOD_NS: u64 = 100_000_000;

@@ -21,8 +21,8 @@ pub const ADDRESS: u8 = 0x0E;
 
 /// The device loop: moves the chip's clock to `now_ns` without a new sample (the held field).
 pub fn tick(mag: &mut Ist8310, now_ns: u64) {
-    let held = mag.held_field();
-    mag.advance(now_ns, held);
+    let held = mag.held();
+    mag.sense_at(now_ns, held);
 }
 
 /// One register write over I2C, every byte acknowledged.

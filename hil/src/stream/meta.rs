@@ -52,8 +52,8 @@ pub(super) fn metadata(
                 gyro_offset: i.gyro_offset,
                 accel_offset: i.accel_offset,
             }),
-            // The ICM-42688-P's conversion is its full scales, already in `[chip]`.
-            Conversion::Icm42688p(_) => None,
+            // The others' conversions are their ranges, already in `[chip]`.
+            Conversion::Icm42688p(_) | Conversion::Ist8310 | Conversion::Qmc5883l(_) => None,
         },
         scene_text: scene.text.clone(),
         device: None,
@@ -70,8 +70,9 @@ fn chip_meta(chip: &ChipSetup, s: &ImageSettings) -> ChipMeta {
         bus: chip.bus.name().to_string(),
         i2c_address: chip.i2c_address,
         image_len: s.chip.model.image_len(),
-        accel_range_g: fs.accel_g,
-        gyro_range_dps: fs.gyro_dps,
+        accel_range_g: fs.map(|fs| fs.accel_g),
+        gyro_range_dps: fs.map(|fs| fs.gyro_dps),
+        mag_range_gauss: s.chip.mag_range_gauss(),
         rotation: chip.rotation,
     }
 }

@@ -236,15 +236,22 @@ mod tests {
                 accel_g: 16.0,
                 gyro_dps: 2000.0,
             };
+            let settings = if model.is_magnetometer_only() {
+                let gauss = ChipSettings::mag_ranges_gauss(model).last().copied();
+                let power_on = ChipSettings::power_on(model);
+                gauss.map_or(power_on, |g| power_on.with_mag_range(g).unwrap())
+            } else {
+                ChipSettings::with_full_scale(model, fs).unwrap()
+            };
             let setup = ChipSetup {
-                settings: ChipSettings::with_full_scale(model, fs).unwrap(),
+                settings,
                 ..ChipSetup::power_on(model)
             };
             let chip = device_chip(&setup, Rate::hz(1000).unwrap()).unwrap();
             assert_eq!(
                 chip.settings(),
                 setup.settings,
-                "{model:?} at ±16 g, ±2000 °/s"
+                "{model:?} at its largest ranges"
             );
         }
     }

@@ -38,36 +38,47 @@ fn list(values: impl Iterator<Item = String>) -> String {
 
 /// The description `margemu chips` prints for `model`.
 pub fn describe(model: ChipModel) -> String {
-    let power_on = ChipSettings::power_on(model).full_scale();
+    let power_on = ChipSettings::power_on(model);
     let mut out = format!(
         "{} ([chip] model = \"{}\")\n",
         model.part_name(),
         model.name()
     );
     out += &format!("  WHO_AM_I:     {}\n", hexes(model.identities()));
+    let spi = model.buses().contains(margemu_protocol::link::Buses::SPI);
     out += &format!(
-        "  buses:        SPI, I2C at {}\n",
+        "  buses:        {}I2C at {}\n",
+        if spi { "SPI, " } else { "" },
         hexes(model.i2c_addresses())
     );
-    out += &format!(
-        "  accel ranges: ± {} g (power-on ±{} g)\n",
-        ranges(ChipSettings::accel_ranges_g(model)),
-        power_on.accel_g
-    );
-    out += &format!(
-        "  gyro ranges:  ± {} °/s (power-on ±{} °/s)\n",
-        ranges(ChipSettings::gyro_ranges_dps(model)),
-        power_on.gyro_dps
-    );
-    out += &format!("  output rates: {}\n", rates(model));
-    out += &format!(
-        "  magnetometer: {}\n",
-        if model.has_magnetometer() {
-            "AK8963 behind the auxiliary I2C master or in bypass at 0x0c"
-        } else {
-            "none"
+    if let Some(fs) = power_on.full_scale() {
+        out += &format!(
+            "  accel ranges: ± {} g (power-on ±{} g)\n",
+            ranges(ChipSettings::accel_ranges_g(model)),
+            fs.accel_g
+        );
+        out += &format!(
+            "  gyro ranges:  ± {} °/s (power-on ±{} °/s)\n",
+            ranges(ChipSettings::gyro_ranges_dps(model)),
+            fs.gyro_dps
+        );
+        out += &format!("  output rates: {}\n", rates(model));
+    }
+    let mag_ranges = ChipSettings::mag_ranges_gauss(model);
+    if let Some(gauss) = power_on.mag_range_gauss() {
+        out += &format!(
+            "  mag ranges:   ± {} G (power-on ±{gauss} G)\n",
+            ranges(mag_ranges.iter().copied())
+        );
+    }
+    let magnetometer = match model {
+        ChipModel::Mpu9250 => "AK8963 behind the auxiliary I2C master or in bypass at 0x0c",
+        _ if model.is_magnetometer_only() => {
+            "the chip itself, measuring on its own schedule (any scene rate)"
         }
-    );
+        _ => "none",
+    };
+    out += &format!("  magnetometer: {magnetometer}\n");
     out += &format!(
         "  image:        {} bytes per sample on the link\n",
         model.image_len()

@@ -208,12 +208,14 @@ pub fn stream_to(
     label: &str,
 ) -> Result<margemu::stream::Summary> {
     let images = session.image_settings();
-    let fs = images.chip.full_scale();
+    let ranges = match (images.chip.full_scale(), images.chip.mag_range_gauss()) {
+        (Some(fs), _) => format!("±{} g, ±{} °/s", fs.accel_g, fs.gyro_dps),
+        (None, Some(gauss)) => format!("±{gauss} G"),
+        (None, None) => "its fixed range".to_string(),
+    };
     eprintln!(
-        "images: {}, ±{} g, ±{} °/s, {} µT per field unit",
+        "images: {}, {ranges}, {} µT per field unit",
         images.chip.model.part_name(),
-        fs.accel_g,
-        fs.gyro_dps,
         images.mag_ut_per_unit
     );
     let bar = ProgressBar::new(session.sample_count());

@@ -32,7 +32,7 @@ mod settings;
 
 pub use image::{Image, MAX_IMAGE_LEN};
 pub use model::{ChipModel, Family};
-pub use settings::{ChipSettings, Conversion, FullScale, Reading, SettingsError};
+pub use settings::{ChipSettings, Conversion, FullScale, MagRangeError, Reading, SettingsError};
 
 /// One physical sample as the chip's sensors would see it, in the chip's accel/gyro axes (each
 /// chip applies its own internal axis quirks, such as the AK8963's, itself).

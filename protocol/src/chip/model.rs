@@ -11,6 +11,10 @@ pub enum Family {
     Mpu6xxx,
     /// TDK InvenSense ICM-42688-P ([`crate::regmap::icm42688p`]).
     Icm42688p,
+    /// iSentek IST8310 magnetometer ([`crate::regmap::ist8310`]).
+    Ist8310,
+    /// QST QMC5883L magnetometer ([`crate::regmap::qmc5883l`]).
+    Qmc5883l,
 }
 
 /// An emulated chip model. Its wire code ([`ChipModel::code`]) is the bit of
@@ -29,16 +33,22 @@ pub enum ChipModel {
     Icm20602 = 3,
     /// TDK InvenSense ICM-42688-P, WHO_AM_I 0x47.
     Icm42688p = 4,
+    /// iSentek IST8310 magnetometer (I2C only), WAI 0x10.
+    Ist8310 = 6,
+    /// QST QMC5883L magnetometer (I2C only), chip id 0xFF.
+    Qmc5883l = 7,
 }
 
 impl ChipModel {
     /// Every model, in code order.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 7] = [
         Self::Mpu9250,
         Self::Mpu6500,
         Self::Mpu6000,
         Self::Icm20602,
         Self::Icm42688p,
+        Self::Ist8310,
+        Self::Qmc5883l,
     ];
 
     /// The model's code on the link.
@@ -59,6 +69,8 @@ impl ChipModel {
             Self::Mpu6000 => "mpu6000",
             Self::Icm20602 => "icm20602",
             Self::Icm42688p => "icm42688p",
+            Self::Ist8310 => "ist8310",
+            Self::Qmc5883l => "qmc5883l",
         }
     }
 
@@ -70,6 +82,8 @@ impl ChipModel {
             Self::Mpu6000 => "MPU-6000",
             Self::Icm20602 => "ICM-20602",
             Self::Icm42688p => "ICM-42688-P",
+            Self::Ist8310 => "IST8310",
+            Self::Qmc5883l => "QMC5883L",
         }
     }
 
@@ -89,11 +103,21 @@ impl ChipModel {
     pub const fn family(self) -> Family {
         match self {
             Self::Icm42688p => Family::Icm42688p,
+            Self::Ist8310 => Family::Ist8310,
+            Self::Qmc5883l => Family::Qmc5883l,
             _ => Family::Mpu6xxx,
         }
     }
 
-    /// The WHO_AM_I value of the part itself (the first of [`ChipModel::identities`]).
+    /// What the part measures: an IMU (accelerometer and gyroscope, perhaps a magnetometer too)
+    /// or a magnetometer alone.
+    pub const fn is_magnetometer_only(self) -> bool {
+        matches!(self, Self::Ist8310 | Self::Qmc5883l)
+    }
+
+    /// The WHO_AM_I value of the part itself (the first of [`ChipModel::identities`]; for the
+    /// magnetometers, the identity register drivers check: the IST8310's WAI, the
+    /// QMC5883L's chip id register 0x0D).
     pub const fn who_am_i(self) -> u8 {
         self.identities()[0]
     }
@@ -107,17 +131,28 @@ impl ChipModel {
             Self::Mpu6000 => &[0x68],
             Self::Icm20602 => &[0x12],
             Self::Icm42688p => &[0x47],
+            Self::Ist8310 => &[crate::regmap::ist8310::WAI_VALUE],
+            Self::Qmc5883l => &[crate::regmap::qmc5883l::CHIP_ID_VALUE],
         }
     }
 
-    /// The buses the part has (every current model: SPI and I2C).
+    /// The buses the part has: SPI and I2C, except the magnetometers (I2C only).
     pub const fn buses(self) -> Buses {
-        Buses(Buses::SPI.0 | Buses::I2C.0)
+        if self.is_magnetometer_only() {
+            Buses::I2C
+        } else {
+            Buses(Buses::SPI.0 | Buses::I2C.0)
+        }
     }
 
-    /// The 7-bit I2C addresses the part can be strapped to (AD0 low first).
+    /// The 7-bit I2C addresses the part can be strapped to (the default first: AD0 low for the
+    /// IMUs; the IST8310's CAD pins give 0x0C–0x0F, 0x0E with both low; the QMC5883L has one).
     pub const fn i2c_addresses(self) -> &'static [u8] {
-        &[0x68, 0x69]
+        match self {
+            Self::Ist8310 => &crate::regmap::ist8310::I2C_ADDRESSES,
+            Self::Qmc5883l => &[crate::regmap::qmc5883l::I2C_ADDRESS],
+            _ => &[0x68, 0x69],
+        }
     }
 
     /// Register files of the model, as [`RegisterOverride::file`](crate::link::RegisterOverride)
@@ -133,7 +168,7 @@ impl ChipModel {
 
     /// Whether the package holds a magnetometer.
     pub const fn has_magnetometer(self) -> bool {
-        matches!(self, Self::Mpu9250)
+        matches!(self, Self::Mpu9250 | Self::Ist8310 | Self::Qmc5883l)
     }
 
     /// What the emulation covers, for `margemu chips` (one line per item; the chip module's
@@ -157,6 +192,16 @@ impl ChipModel {
                 "FIFO: 8-, 16- and 20-byte packets with headers, 20-bit data, timestamps,                  count in bytes or records, lost packets, overflow, watermark",
                 "INT1/INT2: data ready, FIFO threshold and full, reset done; pulse or latched",
             ],
+            Family::Ist8310 => &[
+                "I2C target at its four strap addresses, registers with reset values and masks",
+                "single measurements (CNTL1 = 1) taking the time the averaging (AVGCNTL) needs",
+                "STAT1 DRDY and DOR, self-clearing soft reset, 0.3 uT/LSB with per-axis clipping",
+            ],
+            Family::Qmc5883l => &[
+                "I2C target, registers with reset values, masks and the chip id registers",
+                "continuous mode at 10/50/100/200 Hz, ranges 2 G and 8 G",
+                "STATUS DRDY, OVL and DOR (data skipped), soft reset, pointer roll-over",
+            ],
         }
     }
 
@@ -171,6 +216,10 @@ impl ChipModel {
                 "the anti-alias and UI filters' effect on the data (settings are stored)",
                 "APEX motion features, self-test, external clock (CLKIN), FSYNC",
             ],
+            Family::Ist8310 => {
+                &["temperature output, self-test field, 16-bit output mode, the DRDY pin"]
+            }
+            Family::Qmc5883l => &["temperature output, over-sampling noise, the DRDY pin"],
         }
     }
 
@@ -182,6 +231,8 @@ impl ChipModel {
                 crate::regmap::mpu6xxx::image::SENSORS_LEN
             }
             Self::Icm42688p => crate::regmap::icm42688p::image::IMAGE_LEN,
+            Self::Ist8310 => crate::regmap::ist8310::IMAGE_LEN,
+            Self::Qmc5883l => crate::regmap::qmc5883l::IMAGE_LEN,
         }
     }
 
@@ -199,6 +250,8 @@ impl ChipModel {
                 close(32_000.0) || close(8_000.0) || divided(1_000.0)
             }
             Self::Icm42688p => crate::regmap::icm42688p::Odr::gyro_of_hz(rate_hz).is_some(),
+            // A magnetometer measures on its own schedule; any rate of the rig's IMU serves it.
+            Self::Ist8310 | Self::Qmc5883l => rate_hz > 0.0,
         }
     }
 }

@@ -6,6 +6,7 @@ use crate::regmap::icm42688p::image::{ImageConfig as IcmConfig, ImageRepr as Icm
 use crate::regmap::icm42688p::{self as icm, convert as icm_convert};
 use crate::regmap::mpu6xxx::image::{ImageConfig as Mpu6xxxConfig, ImageRepr as Mpu6xxxRepr};
 use crate::regmap::mpu6xxx::{self as mpu, AccelFs, GyroFs};
+use crate::regmap::{ist8310, mag_image, qmc5883l};
 
 /// The conversion settings of one chip family (full scales, offsets, magnetometer settings).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -14,6 +15,10 @@ pub enum Conversion {
     Mpu6xxx(Mpu6xxxConfig),
     /// ICM-42688-P (full scales; the 20-bit FIFO values have fixed ones).
     Icm42688p(IcmConfig),
+    /// IST8310 (one fixed sensitivity).
+    Ist8310,
+    /// QMC5883L at a range.
+    Qmc5883l(qmc5883l::Range),
 }
 
 /// A full-scale choice: accelerometer range in g, gyroscope range in °/s.
@@ -47,6 +52,13 @@ pub struct Reading {
     pub mag_ut: Option<[f64; 3]>,
 }
 
+/// A magnetometer range the model does not have.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagRangeError {
+    /// The range asked for, ± gauss.
+    pub gauss: f64,
+}
+
 /// A chip model with the register settings its images are computed with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ChipSettings {
@@ -68,8 +80,30 @@ impl ChipSettings {
                 ..Mpu6xxxConfig::NOMINAL
             }),
             Family::Icm42688p => Conversion::Icm42688p(IcmConfig::NOMINAL),
+            Family::Ist8310 => Conversion::Ist8310,
+            Family::Qmc5883l => Conversion::Qmc5883l(qmc5883l::Range::default()),
         };
         Self { model, conversion }
+    }
+
+    /// The magnetometer ranges (± gauss) a driver can choose, smallest first: the QMC5883L's
+    /// two; none for the others (a fixed range, or the AK8963's output-width bit).
+    pub fn mag_ranges_gauss(model: ChipModel) -> &'static [f64] {
+        match model.family() {
+            Family::Qmc5883l => &[2.0, 8.0],
+            _ => &[],
+        }
+    }
+
+    /// These settings with the magnetometer at ± `gauss` (one of
+    /// [`ChipSettings::mag_ranges_gauss`]).
+    pub fn with_mag_range(mut self, gauss: f64) -> Result<Self, MagRangeError> {
+        match &mut self.conversion {
+            Conversion::Qmc5883l(range) if gauss == 2.0 => *range = qmc5883l::Range::Gauss2,
+            Conversion::Qmc5883l(range) if gauss == 8.0 => *range = qmc5883l::Range::Gauss8,
+            _ => return Err(MagRangeError { gauss }),
+        }
+        Ok(self)
     }
 
     /// The power-on settings with the given full scales; an error names a range the model
@@ -97,6 +131,9 @@ impl ChipSettings {
                     .find(|g| g.range_dps() == fs.gyro_dps)
                     .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
             }
+            Conversion::Ist8310 | Conversion::Qmc5883l(_) => {
+                return Err(SettingsError::AccelRange(fs.accel_g))
+            }
         }
         Ok(settings)
     }
@@ -109,6 +146,7 @@ impl ChipSettings {
                 .map(|a| f64::from(a.range_g()))
                 .collect(),
             Family::Icm42688p => icm::AccelFs::ALL.iter().map(|a| a.range_g()).collect(),
+            Family::Ist8310 | Family::Qmc5883l => heapless::Vec::new(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -122,43 +160,60 @@ impl ChipSettings {
                 .map(|g| f64::from(g.range_dps()))
                 .collect(),
             Family::Icm42688p => icm::GyroFs::ALL.iter().map(|g| g.range_dps()).collect(),
+            Family::Ist8310 | Family::Qmc5883l => heapless::Vec::new(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
     }
 
-    /// The full scale in force.
-    pub fn full_scale(&self) -> FullScale {
+    /// The accelerometer and gyroscope full scale in force; `None` for a magnetometer.
+    pub fn full_scale(&self) -> Option<FullScale> {
         match &self.conversion {
-            Conversion::Mpu6xxx(cfg) => FullScale {
+            Conversion::Mpu6xxx(cfg) => Some(FullScale {
                 accel_g: f64::from(cfg.accel_fs.range_g()),
                 gyro_dps: f64::from(cfg.gyro_fs.range_dps()),
-            },
-            Conversion::Icm42688p(cfg) => FullScale {
+            }),
+            Conversion::Icm42688p(cfg) => Some(FullScale {
                 accel_g: cfg.accel_fs.range_g(),
                 gyro_dps: cfg.gyro_fs.range_dps(),
-            },
+            }),
+            Conversion::Ist8310 | Conversion::Qmc5883l(_) => None,
+        }
+    }
+
+    /// The magnetometer range in force, ± gauss, where a driver can choose it
+    /// ([`ChipSettings::mag_ranges_gauss`]).
+    pub fn mag_range_gauss(&self) -> Option<f64> {
+        match &self.conversion {
+            Conversion::Qmc5883l(qmc5883l::Range::Gauss2) => Some(2.0),
+            Conversion::Qmc5883l(qmc5883l::Range::Gauss8) => Some(8.0),
+            _ => None,
         }
     }
 
     /// The register writes, as `(register file, register, value)`, that take a power-on chip to
     /// these full scales and, where one register holds both, to the output rate `rate_hz` (the
     /// ICM-42688-P's GYRO_CONFIG0/ACCEL_CONFIG0; the 6xxx parts keep their power-on rate
-    /// registers). Writes that would store the power-on value are left out.
+    /// registers; the QMC5883L's range in CONF1, in stand-by: its driver starts it). Writes
+    /// that would store the power-on value are left out.
     pub fn config_writes(&self, rate_hz: f64) -> impl Iterator<Item = (u8, u8, u8)> {
-        let writes = match &self.conversion {
-            Conversion::Mpu6xxx(cfg) => [
+        let writes: heapless::Vec<(u8, u8, u8), 2> = match &self.conversion {
+            Conversion::Mpu6xxx(cfg) => heapless::Vec::from_iter([
                 (0, mpu::reg::GYRO_CONFIG, cfg.gyro_fs.bits() << 3),
                 (0, mpu::reg::ACCEL_CONFIG, cfg.accel_fs.bits() << 3),
-            ],
+            ]),
+            Conversion::Ist8310 => heapless::Vec::new(),
+            Conversion::Qmc5883l(range) => {
+                heapless::Vec::from_iter([(0, qmc5883l::reg::CONF1, range.conf1_bits())])
+            }
             Conversion::Icm42688p(cfg) => {
                 let reset = |reg| icm::reset_value(0, reg);
                 let odr = icm::Odr::gyro_of_hz(rate_hz)
                     .map_or(reset(icm::bank0::GYRO_CONFIG0) & 0x0F, icm::Odr::bits);
-                [
+                heapless::Vec::from_iter([
                     (0, icm::bank0::GYRO_CONFIG0, cfg.gyro_fs.bits() << 5 | odr),
                     (0, icm::bank0::ACCEL_CONFIG0, cfg.accel_fs.bits() << 5 | odr),
-                ]
+                ])
             }
         };
         let model = self.model;
@@ -186,6 +241,14 @@ impl ChipSettings {
             Conversion::Icm42688p(cfg) => copy(
                 &mut image,
                 &IcmRepr::from_physical(acc, gyr, temp, cfg).emit(),
+            ),
+            Conversion::Ist8310 => copy(
+                &mut image,
+                &mag_image::emit(ist8310::measurement(sample.mag).0),
+            ),
+            Conversion::Qmc5883l(range) => copy(
+                &mut image,
+                &mag_image::emit(qmc5883l::measurement(sample.mag, *range).0),
             ),
         }
         image
@@ -219,6 +282,19 @@ impl ChipSettings {
                         .map(|v| f64::from(icm_convert::gyro_from_raw(v, cfg.gyro_fs))),
                     temp_c: f64::from(icm_convert::temp_from_raw(r.temp)),
                     mag_ut: None,
+                }
+            }
+            Conversion::Ist8310 | Conversion::Qmc5883l(_) => {
+                let raw = mag_image::parse(image.try_into().ok()?);
+                let mag = match self.conversion {
+                    Conversion::Qmc5883l(range) => qmc5883l::field_ut(raw, range),
+                    _ => ist8310::field_ut(raw),
+                };
+                Reading {
+                    acc: [0.0; 3],
+                    gyr: [0.0; 3],
+                    temp_c: 0.0,
+                    mag_ut: Some(mag),
                 }
             }
         })

@@ -28,8 +28,15 @@
 
 use super::mpu6xxx::convert::round_saturate;
 
-/// The IST8310's default 7-bit I2C address (CAD pins low).
+/// The IST8310's 7-bit I2C address as the drivers use it by default.
 pub const I2C_ADDRESS: u8 = 0x0E;
+
+/// Every 7-bit address the CAD0/CAD1 straps give, the default first (ArduPilot probes all four
+/// for external compasses).
+pub const I2C_ADDRESSES: [u8; 4] = [0x0E, 0x0C, 0x0D, 0x0F];
+
+/// Bytes of one register image: the data registers ([`super::mag_image`]).
+pub const IMAGE_LEN: usize = super::mag_image::IMAGE_LEN;
 
 /// The value of WAI (DS register map; ArduPilot and PX4 probe it).
 pub const WAI_VALUE: u8 = 0x10;
@@ -221,10 +228,14 @@ pub fn measurement(field_ut: [f32; 3]) -> ([i16; 3], bool) {
     (raw, clipped)
 }
 
-/// The data registers DATAXL..=DATAZH of raw values (little endian).
+/// The data registers DATAXL..=DATAZH of raw values (little endian): the chip's image.
 pub fn data_bytes(raw: [i16; 3]) -> [u8; 6] {
-    let [x, y, z] = raw.map(i16::to_le_bytes);
-    [x[0], x[1], y[0], y[1], z[0], z[1]]
+    super::mag_image::emit(raw)
+}
+
+/// The field in µT (chip axes) raw data registers stand for.
+pub fn field_ut(raw: [i16; 3]) -> [f64; 3] {
+    raw.map(|v| f64::from(v) * f64::from(UT_PER_LSB))
 }
 
 /// The next register after `addr` in a burst: the address increments (the drivers' bursts

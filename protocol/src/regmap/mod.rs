@@ -13,7 +13,8 @@
 //!   configuration upload's registers and the conversions (little-endian data, temperature,
 //!   sensor time);
 //! - [`ist8310`]: the iSentek IST8310 standalone I2C magnetometer;
-//! - [`qmc5883l`]: the QST QMC5883L standalone I2C magnetometer.
+//! - [`qmc5883l`]: the QST QMC5883L standalone I2C magnetometer;
+//! - [`mag_image`]: the 6-byte register image both standalone magnetometers share.
 //!
 //! Both the firmware (which serves these values) and the host (which predicts what a driver
 //! reads) call the same functions, so they agree bit for bit.
@@ -28,6 +29,7 @@ pub mod ak8963;
 pub mod bmi270;
 pub mod icm42688p;
 pub mod ist8310;
+pub mod mag_image;
 pub mod mpu6xxx;
 pub mod qmc5883l;
 

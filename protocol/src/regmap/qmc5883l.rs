@@ -32,6 +32,10 @@ use super::mpu6xxx::convert::round_saturate;
 /// The QMC5883L's 7-bit I2C address.
 pub const I2C_ADDRESS: u8 = 0x0D;
 
+/// Bytes of one register image: the data registers ([`super::mag_image`], at the range the
+/// image was computed for).
+pub const IMAGE_LEN: usize = super::mag_image::IMAGE_LEN;
+
 /// The value of the chip ID register 0x0D (DS register map).
 pub const CHIP_ID_VALUE: u8 = 0xFF;
 
@@ -169,6 +173,14 @@ impl Range {
         }
     }
 
+    /// The CONF1 RNG field's bits for this range (00 and 01).
+    pub const fn conf1_bits(self) -> u8 {
+        match self {
+            Self::Gauss2 => 0x00,
+            Self::Gauss8 => 0x10,
+        }
+    }
+
     /// Sensitivity in LSB per µT (1 G = 100 µT): 120 and 30.
     pub const fn lsb_per_ut(self) -> f32 {
         match self {
@@ -186,12 +198,21 @@ pub const MAX_RAW: i16 = 24_000;
 /// clipped at [`MAX_RAW`] (STATUS.OVL). NaN reads 0.
 pub fn measurement(field_ut: [f32; 3], range: Range) -> ([i16; 3], bool) {
     let mut raw = [0i16; 3];
-    let mut overflow = false;
     for (out, b) in raw.iter_mut().zip(field_ut) {
         *out = round_saturate(b * range.lsb_per_ut(), -MAX_RAW, MAX_RAW);
-        overflow |= out.unsigned_abs() >= MAX_RAW.unsigned_abs();
     }
-    (raw, overflow)
+    (raw, overflows(raw))
+}
+
+/// Whether raw data registers report an overflow (STATUS.OVL): an axis at full scale.
+pub fn overflows(raw: [i16; 3]) -> bool {
+    raw.iter()
+        .any(|v| v.unsigned_abs() >= MAX_RAW.unsigned_abs())
+}
+
+/// The field in µT (chip axes) raw data registers stand for at `range`.
+pub fn field_ut(raw: [i16; 3], range: Range) -> [f64; 3] {
+    raw.map(|v| f64::from(v) / f64::from(range.lsb_per_ut()))
 }
 
 /// The next register after `addr` in a burst: with CONF2.ROL_PNT set, 0x06 rolls over to 0x00;

@@ -3,12 +3,13 @@
 //! ```toml
 //! [chip]
 //! model = "icm42688p"        # `margemu chips` lists them; default "mpu9250"
-//! bus = "spi"                # or "i2c"
+//! bus = "spi"                # or "i2c" (default: SPI if the model has it)
 //! address = 0x69             # I2C only: one of the model's addresses (default its first)
 //! who_am_i = 0x47            # an identity variant of the model (default its own)
 //! rotation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]  # plate → chip axes
 //! accel_range = 16           # ± g, one of the model's full scales (default: power-on)
 //! gyro_range = 2000          # ± °/s
+//! mag_range = 8              # ± gauss: a magnetometer with a choice of ranges (QMC5883L: 2, 8)
 //! ```
 //!
 //! A scene without `[chip]` keeps the MPU-9250 at its power-on settings, mounted with the
@@ -52,9 +53,8 @@ impl BusKind {
 pub struct ChipSpec {
     /// The model's name (`ChipModel::name`).
     pub model: Option<String>,
-    /// The bus.
-    #[serde(default)]
-    pub bus: BusKind,
+    /// The bus (default: SPI if the model has it, else I2C).
+    pub bus: Option<BusKind>,
     /// The 7-bit I2C address (I2C only).
     pub address: Option<u8>,
     /// The identity variant (WHO_AM_I value).
@@ -65,6 +65,8 @@ pub struct ChipSpec {
     pub accel_range: Option<f64>,
     /// Gyroscope full scale, ± °/s.
     pub gyro_range: Option<f64>,
+    /// Magnetometer range, ± gauss (the QMC5883L's 2 or 8).
+    pub mag_range: Option<f64>,
 }
 
 /// The chip of a scene, resolved and checked.
@@ -92,12 +94,18 @@ impl Default for ChipSetup {
 }
 
 impl ChipSetup {
-    /// `model` at power-on on SPI at its first address, mounted with the plate's axes.
+    /// `model` at power-on at its first address, on SPI if it has SPI (else I2C), mounted with
+    /// the plate's axes.
     pub fn power_on(model: ChipModel) -> Self {
+        let bus = if model.buses().contains(margemu_protocol::link::Buses::SPI) {
+            BusKind::Spi
+        } else {
+            BusKind::I2c
+        };
         Self {
             model,
             who_am_i: model.who_am_i(),
-            bus: BusKind::Spi,
+            bus,
             i2c_address: model.i2c_addresses()[0],
             rotation: None,
             settings: ChipSettings::power_on(model),
@@ -171,6 +179,74 @@ pub fn ranges(values: impl Iterator<Item = f64>) -> String {
     v.join(", ")
 }
 
+/// The conversion settings `spec` asks of `model`: its full scales (an IMU) or its
+/// magnetometer range; `table` is the spec's key path, for errors.
+fn settings_of(
+    spec: &ChipSpec,
+    model: ChipModel,
+    table: &[&str],
+) -> Result<ChipSettings, Violation> {
+    let part = model.part_name();
+    let at = |key: &'static str| {
+        let mut path = table.to_vec();
+        path.push(key);
+        path
+    };
+    let power_on = ChipSettings::power_on(model);
+    let mut settings = match power_on.full_scale() {
+        Some(power_on_fs) => {
+            let fs = FullScale {
+                accel_g: spec.accel_range.unwrap_or(power_on_fs.accel_g),
+                gyro_dps: spec.gyro_range.unwrap_or(power_on_fs.gyro_dps),
+            };
+            ChipSettings::with_full_scale(model, fs).map_err(|e| match e {
+                SettingsError::AccelRange(g) => Violation::at(
+                    &at("accel_range"),
+                    format!(
+                        "the {part} has no ±{g} g range; its ranges are ± {} g",
+                        ranges(ChipSettings::accel_ranges_g(model))
+                    ),
+                ),
+                SettingsError::GyroRange(dps) => Violation::at(
+                    &at("gyro_range"),
+                    format!(
+                        "the {part} has no ±{dps} °/s range; its ranges are ± {} °/s",
+                        ranges(ChipSettings::gyro_ranges_dps(model))
+                    ),
+                ),
+            })?
+        }
+        None => {
+            let given = [
+                ("accel_range", spec.accel_range),
+                ("gyro_range", spec.gyro_range),
+            ];
+            if let Some((key, _)) = given.iter().find(|(_, v)| v.is_some()) {
+                return Err(Violation::at(
+                    &at(key),
+                    format!("the {part} is a magnetometer: it has no {key}"),
+                ));
+            }
+            power_on
+        }
+    };
+    if let Some(gauss) = spec.mag_range {
+        let choices = ChipSettings::mag_ranges_gauss(model);
+        settings = settings.with_mag_range(gauss).map_err(|_| {
+            let reason = if choices.is_empty() {
+                format!("the {part} has no magnetometer range to choose")
+            } else {
+                format!(
+                    "the {part} has no ±{gauss} G range; its ranges are ± {} G",
+                    ranges(choices.iter().copied())
+                )
+            };
+            Violation::at(&at("mag_range"), reason)
+        })?;
+    }
+    Ok(settings)
+}
+
 /// Resolves `[chip]` (absent: the default MPU-9250) and checks it against the scene's `rate`.
 pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, Violation> {
     let Some(spec) = spec else {
@@ -196,16 +272,17 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
             ),
         ));
     }
-    if !model.buses().contains(match spec.bus {
+    let bus = spec.bus.unwrap_or(ChipSetup::power_on(model).bus);
+    if !model.buses().contains(match bus {
         BusKind::Spi => margemu_protocol::link::Buses::SPI,
         BusKind::I2c => margemu_protocol::link::Buses::I2C,
     }) {
         return Err(Violation::at(
             &["chip", "bus"],
-            format!("the {part} has no {} bus", spec.bus.name()),
+            format!("the {part} has no {} bus", bus.name()),
         ));
     }
-    let i2c_address = match (spec.bus, spec.address) {
+    let i2c_address = match (bus, spec.address) {
         (_, None) => model.i2c_addresses()[0],
         (BusKind::Spi, Some(_)) => {
             return Err(Violation::at(
@@ -227,27 +304,7 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
     if let Some(r) = &spec.rotation {
         check_rotation(r)?;
     }
-    let power_on = ChipSettings::power_on(model).full_scale();
-    let fs = FullScale {
-        accel_g: spec.accel_range.unwrap_or(power_on.accel_g),
-        gyro_dps: spec.gyro_range.unwrap_or(power_on.gyro_dps),
-    };
-    let settings = ChipSettings::with_full_scale(model, fs).map_err(|e| match e {
-        SettingsError::AccelRange(g) => Violation::at(
-            &["chip", "accel_range"],
-            format!(
-                "the {part} has no ±{g} g range; its ranges are ± {} g",
-                ranges(ChipSettings::accel_ranges_g(model))
-            ),
-        ),
-        SettingsError::GyroRange(dps) => Violation::at(
-            &["chip", "gyro_range"],
-            format!(
-                "the {part} has no ±{dps} °/s range; its ranges are ± {} °/s",
-                ranges(ChipSettings::gyro_ranges_dps(model))
-            ),
-        ),
-    })?;
+    let settings = settings_of(spec, model, &["chip"])?;
     if !model.has_output_rate(rate) {
         return Err(Violation::at(
             &["rate"],
@@ -260,7 +317,7 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
     Ok(ChipSetup {
         model,
         who_am_i,
-        bus: spec.bus,
+        bus,
         i2c_address,
         rotation: spec.rotation,
         settings,
