@@ -23,6 +23,18 @@ pub const MARG_COLUMNS: [&str; 10] = [
 /// Header of `perturbation.csv`.
 pub const PERTURBATION_COLUMNS: [&str; 4] = ["t_ns", "mag_x", "mag_y", "mag_z"];
 
+/// The seed of device `index` of a rig whose scene seed is `seed`: the scene's own for the
+/// first device, then steps of the 64-bit golden ratio, so each device draws its own noise.
+///
+/// ```
+/// use margemu_sim::marg::device_seed;
+/// assert_eq!(device_seed(7, 0), 7);
+/// assert_ne!(device_seed(7, 1), device_seed(7, 2));
+/// ```
+pub fn device_seed(seed: u64, index: usize) -> u64 {
+    seed.wrapping_add((index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}
+
 /// The perturbation generator with host-owned buffers.
 type HostPerturbation = Perturbation<Vec<Complex>, Vec<f32>>;
 
@@ -58,16 +70,40 @@ impl MargSample {
 impl MargSim {
     /// The model of `scene` (already validated, so this fails only on a model it refused).
     pub fn new(scene: &Scene) -> Result<Self, margemu_model::Error> {
+        Self::build(scene, &scene.spec.sensors.config(), scene.spec.seed)
+    }
+
+    /// The model of device `index` of `scene`'s rig ([`Scene::devices`]): the scene's sensor
+    /// terms on the device's own seed ([`device_seed`]), its lever arm
+    /// ([`ChipSetup::offset`](crate::scene::chip::ChipSetup::offset), turned into the chip's
+    /// axes) added to `[sensors.accel] lever_arm`. Device 0 is [`MargSim::new`]'s model when it
+    /// has no offset. `None` if the scene has no such device.
+    pub fn for_device(scene: &Scene, index: usize) -> Option<Result<Self, margemu_model::Error>> {
+        let device = scene.devices.get(index)?;
+        let mut config = scene.spec.sensors.config();
+        if let Some(offset) = device.chip.offset {
+            let r = device.chip.to_chip(offset);
+            let base = config.accel.lever_arm_m.unwrap_or([0.0; 3]);
+            config.accel.lever_arm_m = Some([0, 1, 2].map(|i| base[i] + r[i]));
+        }
+        Some(Self::build(scene, &config, device_seed(scene.spec.seed, index)))
+    }
+
+    fn build(
+        scene: &Scene,
+        config: &sensor::MargConfig,
+        seed: u64,
+    ) -> Result<Self, margemu_model::Error> {
         let spec = &scene.spec;
         let rate = scene.clock.hz();
-        let marg = Marg::new(&spec.sensors.config(), rate, spec.seed)?;
+        let marg = Marg::new(config, rate, seed)?;
         let perturbation = match &spec.perturbation {
             None => None,
             Some(p) => {
                 let plan = PerturbationPlan::new(&p.config(), rate)?;
                 let scratch = vec![Complex::default(); plan.scratch_len()];
                 let signal = vec![0.0f32; plan.signal_len()];
-                Some(Perturbation::new(&plan, spec.seed, scratch, signal)?)
+                Some(Perturbation::new(&plan, seed, scratch, signal)?)
             }
         };
         Ok(Self {

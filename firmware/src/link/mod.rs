@@ -69,6 +69,7 @@
 //! assert_eq!(frames, 2); // Reset (after boot), HelloAck
 //! ```
 
+pub mod rig;
 mod ring;
 pub mod setup;
 
@@ -77,14 +78,15 @@ pub use ring::{Insert, SampleRing};
 use margemu_model::sensor::Truth;
 use margemu_protocol::link::{max_images_per_batch, ServedBatch, ServedSample, CRC32C};
 use margemu_protocol::link::{
-    Accumulator, Bus, Buses, Capabilities, Configure, Credit, DeviceState, Encoder, ErrorCode,
+    Accumulator, AddDevice, Bus, Buses, Capabilities, Configure, Credit, DeviceState, Encoder, ErrorCode,
     ErrorReport, FeedResult, FirmwareVersion, Frame, Hello, HelloAck, Image, Kind, Message, Modes,
     Rate, RegisterWrite, RegisterWriteBatch, Reset, ResetCause, RxStats, SeqTracker, Source, Start,
     Telemetry, DEVICE_ID_LEN, MAX_WIRE_LEN,
 };
 use margemu_protocol::PROTOCOL_VERSION;
 
-use crate::chip::{self, Chip, EmulatedChip};
+use crate::chip::{self, EmulatedChip};
+use rig::Rig;
 use setup::Model;
 
 /// The shortest image of any model (the standalone magnetometers).
@@ -175,7 +177,7 @@ pub struct Device<const N: usize = 128> {
 }
 
 struct Core<const N: usize> {
-    chip: EmulatedChip,
+    rig: Rig,
     identity: Identity,
     state: DeviceState,
     session: Option<Session>,
@@ -222,7 +224,7 @@ impl<const N: usize> Device<N> {
         Self {
             rx: Accumulator::new(),
             core: Core {
-                chip: EmulatedChip::default(),
+                rig: Rig::new(EmulatedChip::default()),
                 identity,
                 state: DeviceState::Idle,
                 session: None,
@@ -270,14 +272,25 @@ impl<const N: usize> Device<N> {
         self.core.poll(now_ns, tx);
     }
 
-    /// The emulated chip, for the board's (or the host's) SPI/I2C target.
+    /// The emulated chip (a rig's device 0), for the board's (or the host's) SPI/I2C target.
     pub fn chip_mut(&mut self) -> &mut EmulatedChip {
-        &mut self.core.chip
+        self.core.rig.primary_mut()
     }
 
-    /// The emulated chip.
+    /// The emulated chip (a rig's device 0).
     pub fn chip(&self) -> &EmulatedChip {
-        &self.core.chip
+        self.core.rig.primary()
+    }
+
+    /// Every chip served, device 0 first.
+    pub fn rig(&self) -> &Rig {
+        &self.core.rig
+    }
+
+    /// Every chip served, for a board's SPI and I2C targets ([`Rig::spi_target`],
+    /// [`Rig::i2c_target`]).
+    pub fn rig_mut(&mut self) -> &mut Rig {
+        &mut self.core.rig
     }
 
     /// The counters.
@@ -364,6 +377,7 @@ impl<const N: usize> Core<N> {
             Message::Configure(c) => self.configure(&c, seq, now_ns),
             Message::Start(s) => self.start(s, seq, now_ns),
             Message::Stop => self.stop(now_ns),
+            Message::AddDevice(a) => self.add_device(&a, seq),
             Message::Images(b) => {
                 let configured = self.session.map(|s| usize::from(s.image_len));
                 if !b.images.is_empty() && configured.is_some_and(|n| n != b.images.image_len()) {
@@ -443,7 +457,7 @@ impl<const N: usize> Core<N> {
             images: model.is_none(),
             image_len: c.image_len,
         });
-        self.chip = chip;
+        self.rig = Rig::new(chip);
         self.model = model;
         self.clock = None;
         self.ring.reset(0);
@@ -451,6 +465,23 @@ impl<const N: usize> Core<N> {
         self.state = DeviceState::Configured;
         self.credit_pending = true;
         self.next_telemetry_local_ns = now_ns.saturating_add(period);
+    }
+
+    fn add_device(&mut self, a: &AddDevice, seq: u16) {
+        let Some(session) = self.session.as_mut() else {
+            return self.refuse(ErrorCode::NotConfigured, seq, 0);
+        };
+        if self.state == DeviceState::Running {
+            return self.refuse(ErrorCode::InvalidConfig, seq, DeviceState::Running as u32);
+        }
+        if !session.images {
+            return self.refuse(ErrorCode::RigRefused, seq, 4);
+        }
+        match self.rig.add(a) {
+            // At most MAX_DEVICES images of at most 32 bytes: within MAX_IMAGE_LEN (128).
+            Ok(()) => session.image_len = self.rig.image_len() as u8,
+            Err(e) => self.refuse(e.code, seq, e.detail),
+        }
     }
 
     fn start(&mut self, s: Start, seq: u16, now_ns: u64) {
@@ -564,7 +595,7 @@ impl<const N: usize> Core<N> {
             clock.next_k += 1;
         }
         self.clock = Some(clock);
-        self.chip.advance(now);
+        self.rig.advance(now);
     }
 
     fn serve(&mut self, k: u64, t: u64) {
@@ -583,11 +614,11 @@ impl<const N: usize> Core<N> {
                     }
                     _ => false,
                 };
-                (model.image(&self.chip), !fresh)
+                (model.image(self.rig.primary()), !fresh)
             }
         };
         if let Some(image) = &image {
-            self.chip.latch_image_at(image, t);
+            self.rig.latch_image_at(image, t);
         }
         self.last_image = image.or(self.last_image);
         let c = &mut self.counters;
@@ -725,15 +756,15 @@ impl<const N: usize> Core<N> {
             }; WRITES_PER_FRAME];
             let mut n = 0;
             while n < WRITES_PER_FRAME {
-                let Some(w) = self.chip.pop_write() else {
+                let Some((w, chip_select)) = self.rig.pop_write() else {
                     break;
                 };
                 if let Some(slot) = batch.get_mut(n) {
-                    *slot = wire_write(&w, time_ns);
+                    *slot = wire_write(&w, chip_select, time_ns);
                 }
                 n += 1;
             }
-            let total = self.chip.writes_dropped();
+            let total = self.rig.writes_dropped();
             let dropped = total.wrapping_sub(self.writes_dropped_seen);
             if n == 0 && dropped == 0 {
                 return;
@@ -748,9 +779,10 @@ impl<const N: usize> Core<N> {
     }
 }
 
-fn wire_write(w: &chip::RegisterWrite, time_ns: u64) -> RegisterWrite {
+/// A chip's register write on the wire; an SPI write carries its device's `chip_select`.
+fn wire_write(w: &chip::RegisterWrite, chip_select: u8, time_ns: u64) -> RegisterWrite {
     let (bus, address) = match w.bus {
-        chip::Bus::Spi => (Bus::Spi, 0),
+        chip::Bus::Spi => (Bus::Spi, chip_select),
         chip::Bus::I2c => (Bus::I2c, w.device),
         chip::Bus::Aux => (Bus::AuxMaster, w.device),
     };

@@ -3,12 +3,16 @@
 use core::fmt;
 use core::ops::Deref;
 
-/// The longest image of any model (the ICM-42688-P's 32 bytes).
-pub const MAX_IMAGE_LEN: usize = 32;
+/// The longest image of any one model (the ICM-42688-P's 32 bytes).
+pub const MAX_CHIP_IMAGE_LEN: usize = 32;
+
+/// The longest image the link carries: a rig's, every device's image back to back
+/// ([`MAX_DEVICES`](crate::link::MAX_DEVICES) of [`MAX_CHIP_IMAGE_LEN`]).
+pub const MAX_IMAGE_LEN: usize = crate::link::MAX_DEVICES * MAX_CHIP_IMAGE_LEN;
 
 /// One sample's register image: `len` bytes laid out by the chip module of its model (see
-/// [`ChipModel::image_len`](super::ChipModel::image_len)), the unit the link carries in source
-/// mode (a). Dereferences to its bytes; the bytes beyond `len` are always zero, so equality and
+/// [`ChipModel::image_len`](super::ChipModel::image_len)), or a rig's images back to back: the
+/// unit the link carries in source mode (a). Dereferences to its bytes; the bytes beyond `len` are always zero, so equality and
 /// hashing see only the image.
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Image {

@@ -30,7 +30,7 @@ mod image;
 mod model;
 mod settings;
 
-pub use image::{Image, MAX_IMAGE_LEN};
+pub use image::{Image, MAX_CHIP_IMAGE_LEN, MAX_IMAGE_LEN};
 pub use model::{ChipModel, Family};
 pub use settings::{ChipSettings, Conversion, FullScale, MagRangeError, Reading, SettingsError};
 

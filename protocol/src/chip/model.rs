@@ -265,7 +265,7 @@ mod tests {
         for m in ChipModel::ALL {
             assert_eq!(ChipModel::from_code(m.code()), Some(m));
             assert_eq!(ChipModel::from_name(m.name()), Some(m));
-            assert!(m.image_len() <= super::super::MAX_IMAGE_LEN);
+            assert!(m.image_len() <= super::super::MAX_CHIP_IMAGE_LEN);
         }
         assert_eq!(
             ChipModel::from_name("ICM-42688-P"),

@@ -10,6 +10,9 @@
 //! accel_range = 16           # ± g, one of the model's full scales (default: power-on)
 //! gyro_range = 2000          # ± °/s
 //! mag_range = 8              # ± gauss: a magnetometer with a choice of ranges (QMC5883L: 2, 8)
+//! chip_select = 0            # SPI only: the chip-select line, 0..=3 (default 0)
+//! offset = [0.02, 0.0, -0.01]  # m, plate axes: the lever arm from the plate's reference point
+//! name = "imu"               # the device's name in logs (default: the model's name)
 //! ```
 //!
 //! A scene without `[chip]` keeps the MPU-9250 at its power-on settings, mounted with the
@@ -22,6 +25,13 @@ use super::error::Violation;
 use margemu_protocol::chip::{ChipModel, ChipSettings, FullScale, SettingsError};
 use margemu_protocol::link::{Configure, Rate, RegisterOverride};
 use serde::Deserialize;
+
+/// Chip-select lines a scene may name (a board's SPI target has at most this many).
+pub const MAX_CHIP_SELECTS: u8 = 4;
+
+/// The largest lever arm accepted, m per coordinate (a flight controller is centimetres across;
+/// a metre catches a value in mm).
+pub const MAX_OFFSET_M: f64 = 1.0;
 
 /// A 3×3 matrix, row by row.
 pub type Rotation = [[f64; 3]; 3];
@@ -67,6 +77,13 @@ pub struct ChipSpec {
     pub gyro_range: Option<f64>,
     /// Magnetometer range, ± gauss (the QMC5883L's 2 or 8).
     pub mag_range: Option<f64>,
+    /// The device's name in logs (a rig's `[[device]]`; default: the model's name).
+    pub name: Option<String>,
+    /// SPI only: the chip-select line the device under test drives for it (default 0).
+    pub chip_select: Option<u8>,
+    /// Where the chip sits on the plate, m, plate axes, from the plate's reference point (the
+    /// lever arm: the chip senses the specific force of that point).
+    pub offset: Option<[f64; 3]>,
 }
 
 /// The chip of a scene, resolved and checked.
@@ -84,6 +101,10 @@ pub struct ChipSetup {
     pub rotation: Option<Rotation>,
     /// The conversion settings the images are computed with.
     pub settings: ChipSettings,
+    /// SPI: the chip-select line.
+    pub chip_select: u8,
+    /// The lever arm, m, plate axes; `None`: at the plate's reference point.
+    pub offset: Option<[f64; 3]>,
 }
 
 impl Default for ChipSetup {
@@ -109,6 +130,8 @@ impl ChipSetup {
             i2c_address: model.i2c_addresses()[0],
             rotation: None,
             settings: ChipSettings::power_on(model),
+            chip_select: 0,
+            offset: None,
         }
     }
 
@@ -309,10 +332,34 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
         return Err(Violation::at(
             &["rate"],
             format!(
-                "{rate} Hz is not an output rate of the {part} ([chip] model = {:?})",
+                "{rate} Hz is not an output rate of the {part} (model = {:?})",
                 model.name()
             ),
         ));
+    }
+    let chip_select = match (bus, spec.chip_select) {
+        (_, None) => 0,
+        (BusKind::Spi, Some(cs)) if cs < MAX_CHIP_SELECTS => cs,
+        (BusKind::Spi, Some(cs)) => {
+            return Err(Violation::at(
+                &["chip", "chip_select"],
+                format!("chip select {cs} is not one of 0..={}", MAX_CHIP_SELECTS - 1),
+            ))
+        }
+        (BusKind::I2c, Some(_)) => {
+            return Err(Violation::at(
+                &["chip", "chip_select"],
+                "a chip select applies to bus = \"spi\" only",
+            ))
+        }
+    };
+    if let Some(offset) = spec.offset {
+        if offset.iter().any(|x| !x.is_finite() || x.abs() > MAX_OFFSET_M) {
+            return Err(Violation::at(
+                &["chip", "offset"],
+                format!("each coordinate must be finite and within ±{MAX_OFFSET_M} m"),
+            ));
+        }
     }
     Ok(ChipSetup {
         model,
@@ -321,6 +368,8 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
         i2c_address,
         rotation: spec.rotation,
         settings,
+        chip_select,
+        offset: spec.offset.filter(|o| *o != [0.0; 3]),
     })
 }
 

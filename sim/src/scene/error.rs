@@ -67,6 +67,13 @@ impl Violation {
         }
     }
 
+    pub fn at_path(path: Vec<PathPart>, reason: impl Into<String>) -> Self {
+        Self {
+            path,
+            reason: reason.into(),
+        }
+    }
+
     pub fn index(mut self, i: usize) -> Self {
         self.path.push(PathPart::Index(i));
         self

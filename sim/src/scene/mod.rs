@@ -24,6 +24,7 @@ pub mod builtin;
 pub mod chip;
 mod error;
 pub mod ranges;
+pub mod rig;
 mod schema;
 pub mod sensors;
 pub mod size;
@@ -52,8 +53,11 @@ pub struct Scene {
     pub duration_ns: Nanos,
     /// Integrator sub-step in nanoseconds.
     pub step_ns: Nanos,
-    /// The emulated chip (`[chip]`, or the default MPU-9250).
+    /// The primary chip: `[chip]`, the first `[[device]]`, or the default MPU-9250.
     pub chip: chip::ChipSetup,
+    /// Every device the scene's rig serves, the primary first ([`rig`]); one for a scene with
+    /// `[chip]` or none.
+    pub devices: Vec<rig::Device>,
     /// Legal but likely wrong inputs, located (commands print them once, to stderr).
     pub warnings: Vec<SceneWarning>,
 }
@@ -86,7 +90,8 @@ impl Scene {
             clock: checked.clock,
             duration_ns: checked.duration_ns,
             step_ns: checked.step_ns,
-            chip: checked.chip,
+            chip: checked.devices.first().map(|d| d.chip).unwrap_or_default(),
+            devices: checked.devices,
             warnings,
         };
         scene.check_gains()?;

@@ -54,6 +54,9 @@ pub struct SceneSpec {
     /// The emulated chip; the MPU-9250 at power-on when the table is absent.
     #[serde(default)]
     pub chip: Option<super::chip::ChipSpec>,
+    /// The devices of a rig (`[[device]]`), instead of `[chip]`.
+    #[serde(default)]
+    pub device: Vec<super::chip::ChipSpec>,
 }
 
 /// How the plate's motion is produced; a scene pays only for the mode it names.

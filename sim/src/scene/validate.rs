@@ -11,7 +11,7 @@ pub(crate) struct Checked {
     pub clock: SampleClock,
     pub duration_ns: Nanos,
     pub step_ns: Nanos,
-    pub chip: super::chip::ChipSetup,
+    pub devices: Vec<super::rig::Device>,
     /// Legal but likely wrong inputs.
     pub warnings: Vec<Violation>,
 }
@@ -50,12 +50,12 @@ pub(crate) fn check(spec: &SceneSpec) -> Result<Checked, Violation> {
         check_joint(name, source, spec.motion)?;
     }
     check_sensors(spec)?;
-    let chip = super::chip::resolve(spec.chip.as_ref(), spec.rate)?;
+    let devices = super::rig::resolve(spec.chip.as_ref(), &spec.device, spec.rate)?;
     Ok(Checked {
         clock,
         duration_ns,
         step_ns,
-        chip,
+        devices,
         warnings: super::warnings::collect(spec),
     })
 }

@@ -10,6 +10,7 @@
 //! | 0x02 | [`Configure`] | host → device |
 //! | 0x03 | [`Start`] | host → device |
 //! | 0x04 | [`Message::Stop`] | host → device |
+//! | 0x05 | [`AddDevice`] | host → device |
 //! | 0x10 | [`ImageBatch`] | host → device |
 //! | 0x11 | [`KinematicsBatch`] | host → device |
 //! | 0x81 | [`HelloAck`] | device → host |
@@ -36,6 +37,7 @@
 mod macros;
 mod batch;
 mod configure;
+mod device;
 mod images;
 mod model_terms;
 mod session;
@@ -48,6 +50,7 @@ pub use batch::{
 };
 pub use configure::{Configure, ModelParams, Rate, RegisterOverride, Source};
 pub use configure::{MAX_CONFIGURE_LEN, MAX_OVERRIDES};
+pub use device::{AddDevice, DeviceBus, MAX_DEVICES, MAX_DEVICE_OVERRIDES};
 pub use images::{
     max_images_per_batch, Image, ImageBatch, ImageItems, IMAGE_BATCH_HEADER_LEN, MAX_IMAGE_LEN,
 };
@@ -72,6 +75,8 @@ code_enum! {
         Start = 0x03,
         /// [`Message::Stop`].
         Stop = 0x04,
+        /// [`AddDevice`].
+        AddDevice = 0x05,
         /// [`ImageBatch`].
         Images = 0x10,
         /// [`KinematicsBatch`].
@@ -115,6 +120,8 @@ pub enum Message<'a> {
     Start(Start),
     /// Host: stop serving samples (empty payload).
     Stop,
+    /// Host: one more chip of a rig.
+    AddDevice(AddDevice),
     /// Host: finished register images.
     Images(ImageBatch<'a>),
     /// Host: true kinematics for the on-device model.
@@ -143,6 +150,7 @@ impl<'a> Message<'a> {
             Self::Configure(_) => Kind::Configure,
             Self::Start(_) => Kind::Start,
             Self::Stop => Kind::Stop,
+            Self::AddDevice(_) => Kind::AddDevice,
             Self::Images(_) => Kind::Images,
             Self::Kinematics(_) => Kind::Kinematics,
             Self::HelloAck(_) => Kind::HelloAck,
@@ -169,6 +177,7 @@ impl<'a> Message<'a> {
             Kind::Configure => Self::Configure(Configure::parse(&mut r)?),
             Kind::Start => Self::Start(Start::parse(&mut r)?),
             Kind::Stop => Self::Stop,
+            Kind::AddDevice => Self::AddDevice(AddDevice::parse(&mut r)?),
             Kind::Images => Self::Images(ImageBatch::parse(&mut r)?),
             Kind::Kinematics => Self::Kinematics(KinematicsBatch::parse(&mut r)?),
             Kind::HelloAck => Self::HelloAck(HelloAck::parse(&mut r)?),
@@ -190,6 +199,7 @@ impl<'a> Message<'a> {
             Self::Configure(m) => m.buffer_len(),
             Self::Start(_) => Start::LEN,
             Self::Stop => 0,
+            Self::AddDevice(m) => m.buffer_len(),
             Self::Images(m) => m.buffer_len(),
             Self::Kinematics(m) => m.buffer_len(),
             Self::HelloAck(_) => HelloAck::LEN,
@@ -211,6 +221,7 @@ impl<'a> Message<'a> {
             Self::Configure(m) => m.emit(&mut w),
             Self::Start(m) => m.emit(&mut w),
             Self::Stop => Ok(()),
+            Self::AddDevice(m) => m.emit(&mut w),
             Self::Images(m) => m.emit(&mut w),
             Self::Kinematics(m) => m.emit(&mut w),
             Self::HelloAck(m) => m.emit(&mut w),

@@ -307,6 +307,10 @@ code_enum! {
         CreditExceeded = 8,
         /// Anything else.
         Internal = 9,
+        /// [`AddDevice`](super::AddDevice) refused: the rig is full, its address or chip
+        /// select is another device's, or the source is the on-device model (`detail`: 1 full,
+        /// 2 I2C address taken, 3 chip select taken, 4 model source).
+        RigRefused = 10,
     }
 }
 
