@@ -1,58 +1,58 @@
-//! Several I2C targets on one bus, seen by the controller as one [`I2cTarget`].
-//!
-//! [`I2cBus`] is the wiring between chips, not a controller: put it behind the [`I2c`] adapter
-//! (through [`shared`]) and a driver talks to every chip on it, each at its own addresses.
-//!
-//! **What each target sees** is what it would see on a real bus, where every device watches SDA
-//! and SCL:
-//! - every START and repeated START, with its address and direction, goes to every target, and
-//!   each answers for its own addresses (a chip that watches bus activity, as the MPU-9250's
-//!   bypass multiplexer does, sees the traffic to its neighbours);
-//! - the bytes that follow go only to the targets that acknowledged that START; if none did,
-//!   the address was NACKed ([`I2c`] reports it as
-//!   [`NoAcknowledge(Address)`](embedded_hal::i2c::NoAcknowledgeSource::Address)), and the
-//!   bytes until the next START reach nobody: writes are NACKed and reads return `0xFF`, the
-//!   released open-drain line;
-//! - every STOP goes to every target.
-//!
-//! Two targets acknowledging one address (an address conflict, such as two chips strapped
-//! alike) behave as open-drain wiring does: a byte written is ACKed if either target ACKs it,
-//! and a byte read is the AND of both targets' bytes.
-//!
-//! **Ownership.** A target is either owned by the bus ([`I2cBus::with`]) or shared with the test
-//! bench ([`I2cBus::with_shared`]), which keeps its own handle to latch samples or advance time
-//! between driver calls. A shared target that is borrowed elsewhere when the bus needs it does
-//! not take part in that bus event (as a chip held in reset would not) and the bus counts it in
-//! [`I2cBus::missed_events`]; nothing panics.
-//!
-//! ```
-//! use embedded_hal::i2c::{Error as _, ErrorKind, I2c as _, NoAcknowledgeSource};
-//! use margemu_firmware::chip::{Ist8310, Qmc5883l};
-//! use margemu_hil::bus::{self, I2c, I2cBus};
-//!
-//! let ist8310 = bus::shared(Ist8310::new());
-//! let wires = I2cBus::new().with_shared(ist8310.clone()).with(Qmc5883l::new());
-//! let mut i2c = I2c::new(bus::shared(wires));
-//!
-//! let mut id = [0u8; 1];
-//! i2c.write_read(0x0E, &[0x00], &mut id).unwrap(); // IST8310 WAI
-//! assert_eq!(id, [0x10]);
-//! i2c.write_read(0x0D, &[0x0D], &mut id).unwrap(); // QMC5883L chip ID
-//! assert_eq!(id, [0xFF]);
-//!
-//! let err = i2c.write_read(0x1E, &[0x0A], &mut id).unwrap_err(); // nobody at 0x1E
-//! assert_eq!(err.kind(), ErrorKind::NoAcknowledge(NoAcknowledgeSource::Address));
-//!
-//! ist8310.borrow_mut().advance(1_000_000, [0.0; 3]); // the bench keeps its handle
-//! ```
-//!
-//! [`I2c`]: super::I2c
-//! [`shared`]: super::shared
+//! Several I2C targets on one bus, seen by the controller as one target: [`I2cBus`].
 
 use super::Shared;
 use margemu_firmware::chip::I2cTarget;
 
-/// Several targets on one I2C bus, itself an [`I2cTarget`]: see the [module docs](self).
+/// Several I2C targets on one bus, seen by the controller as one [`I2cTarget`].
+///
+/// It is the wiring between chips, not a controller: put it behind the [`I2c`] adapter (through
+/// [`shared`]) and a driver talks to every chip on it, each at its own addresses.
+///
+/// **What each target sees** is what it would see on a real bus, where every device watches SDA
+/// and SCL:
+/// - every START and repeated START, with its address and direction, goes to every target, and
+///   each answers for its own addresses (a chip that watches bus activity, as the MPU-9250's
+///   bypass multiplexer does, sees the traffic to its neighbours);
+/// - the bytes that follow go only to the targets that acknowledged that START; if none did,
+///   the address was NACKed ([`I2c`] reports it as
+///   [`NoAcknowledge(Address)`](embedded_hal::i2c::NoAcknowledgeSource::Address)), and the
+///   bytes until the next START reach nobody: writes are NACKed and reads return `0xFF`, the
+///   released open-drain line;
+/// - every STOP goes to every target.
+///
+/// Two targets acknowledging one address (an address conflict, such as two chips strapped
+/// alike) behave as open-drain wiring does: a byte written is ACKed if either target ACKs it,
+/// and a byte read is the AND of both targets' bytes.
+///
+/// **Ownership.** A target is either owned by the bus ([`I2cBus::with`]) or shared with the test
+/// bench ([`I2cBus::with_shared`]), which keeps its own handle to latch samples or advance time
+/// between driver calls. A shared target that is borrowed elsewhere when the bus needs it does
+/// not take part in that bus event (as a chip held in reset would not) and the bus counts it in
+/// [`I2cBus::missed_events`]; nothing panics.
+///
+/// ```
+/// use embedded_hal::i2c::{Error as _, ErrorKind, I2c as _, NoAcknowledgeSource};
+/// use margemu_firmware::chip::{Ist8310, Qmc5883l};
+/// use margemu_hil::bus::{self, I2c, I2cBus};
+///
+/// let ist8310 = bus::shared(Ist8310::new());
+/// let wires = I2cBus::new().with_shared(ist8310.clone()).with(Qmc5883l::new());
+/// let mut i2c = I2c::new(bus::shared(wires));
+///
+/// let mut id = [0u8; 1];
+/// i2c.write_read(0x0E, &[0x00], &mut id).unwrap(); // IST8310 WAI
+/// assert_eq!(id, [0x10]);
+/// i2c.write_read(0x0D, &[0x0D], &mut id).unwrap(); // QMC5883L chip ID
+/// assert_eq!(id, [0xFF]);
+///
+/// let err = i2c.write_read(0x1E, &[0x0A], &mut id).unwrap_err(); // nobody at 0x1E
+/// assert_eq!(err.kind(), ErrorKind::NoAcknowledge(NoAcknowledgeSource::Address));
+///
+/// ist8310.borrow_mut().advance(1_000_000, [0.0; 3]); // the bench keeps its handle
+/// ```
+///
+/// [`I2c`]: super::I2c
+/// [`shared`]: super::shared
 #[derive(Default)]
 pub struct I2cBus {
     slots: Vec<Slot>,
