@@ -3,37 +3,27 @@
 //! that moves the chip's clock, known fields and the "within one LSB" check.
 #![allow(dead_code)] // each test file uses its own part
 
-use margemu_firmware::chip::{Ist8310, Qmc5883l};
+use margemu_firmware::chip::{Chip, Ist8310, PhysicalSample, Qmc5883l};
 use margemu_hil::bus::{Clock, Shared};
 
 /// One millisecond in the chips' nanoseconds.
 pub const MS: u64 = 1_000_000;
 
-/// A chip driven by time: the field it senses and its clock (both chips have this face).
-pub trait MagChip {
+/// A chip driven by time through its chip boundary: a field latched at an instant, or the
+/// clock moved on with the field it holds.
+pub trait MagChip: Chip {
     /// Moves the chip's clock to `now_ns` with `field_ut` sensed from then on.
-    fn advance(&mut self, now_ns: u64, field_ut: [f32; 3]);
-    /// The field the chip senses now.
-    fn held_field(&self) -> [f32; 3];
-}
-
-impl MagChip for Ist8310 {
-    fn advance(&mut self, now_ns: u64, field_ut: [f32; 3]) {
-        Ist8310::advance(self, now_ns, field_ut);
-    }
-    fn held_field(&self) -> [f32; 3] {
-        Ist8310::held_field(self)
+    fn sense(&mut self, now_ns: u64, field_ut: [f32; 3]) {
+        let sample = PhysicalSample {
+            mag: field_ut,
+            ..PhysicalSample::default()
+        };
+        Chip::latch_at(self, &sample, now_ns);
     }
 }
 
-impl MagChip for Qmc5883l {
-    fn advance(&mut self, now_ns: u64, field_ut: [f32; 3]) {
-        Qmc5883l::advance(self, now_ns, field_ut);
-    }
-    fn held_field(&self) -> [f32; 3] {
-        Qmc5883l::held_field(self)
-    }
-}
+impl MagChip for Ist8310 {}
+impl MagChip for Qmc5883l {}
 
 /// The bench side of one chip: its clock and the field it senses.
 pub struct Bench<C> {
@@ -53,7 +43,7 @@ impl<C: MagChip> Bench<C> {
     /// with it), then holds `field_ut` from `now_ns` on.
     pub fn latch(&self, now_ns: u64, field_ut: [f32; 3]) {
         self.run_to(now_ns);
-        self.chip.borrow_mut().advance(now_ns, field_ut);
+        self.chip.borrow_mut().sense(now_ns, field_ut);
     }
 
     /// Lets time run to `now_ns` with the field held so far.
@@ -61,8 +51,7 @@ impl<C: MagChip> Bench<C> {
         self.clock
             .advance_ns(now_ns.saturating_sub(self.clock.now_ns()));
         let mut chip = self.chip.borrow_mut();
-        let field = chip.held_field();
-        chip.advance(self.clock.now_ns(), field);
+        Chip::advance(&mut *chip, self.clock.now_ns());
     }
 
     /// The driver's delay on this bench's clock.
@@ -85,8 +74,7 @@ impl<C: MagChip> embedded_hal_02::blocking::delay::DelayMs<u8> for ChipDelay<C> 
     fn delay_ms(&mut self, ms: u8) {
         self.clock.advance_ns(u64::from(ms) * MS);
         let mut chip = self.chip.borrow_mut();
-        let field = chip.held_field();
-        chip.advance(self.clock.now_ns(), field);
+        Chip::advance(&mut *chip, self.clock.now_ns());
     }
 }
 
