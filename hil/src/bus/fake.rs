@@ -56,12 +56,14 @@ enum Phase {
 
 /// Sixteen registers with an auto-incrementing pointer (wrapping at 16).
 ///
-/// SPI: the first byte is `0x80 | reg` to read or `reg` to write. I2C at [`Regs::ADDRESS`]: the
-/// first byte written after a START sets the pointer; [`Regs::READ_ONLY`] refuses writes (NACK).
+/// SPI: the first byte is `0x80 | reg` to read or `reg` to write. I2C at its address
+/// ([`Regs::ADDRESS`] unless made with [`Regs::counting_at`]): the first byte written after a
+/// START sets the pointer; [`Regs::READ_ONLY`] refuses writes (NACK).
 #[derive(Default)]
 pub struct Regs {
     pub regs: [u8; 16],
     pub log: Vec<Event>,
+    address: u8,
     ptr: usize,
     phase: Phase,
 }
@@ -70,10 +72,16 @@ impl Regs {
     pub const ADDRESS: u8 = 0x68;
     pub const READ_ONLY: usize = 0x0F;
 
-    /// Registers holding `0x10 + i`.
+    /// Registers holding `0x10 + i`, at [`Regs::ADDRESS`].
     pub fn counting() -> Self {
+        Self::counting_at(Self::ADDRESS, 0x10)
+    }
+
+    /// Registers holding `first + i`, answering I2C `address`.
+    pub fn counting_at(address: u8, first: u8) -> Self {
         Self {
-            regs: core::array::from_fn(|i| 0x10 + i as u8),
+            regs: core::array::from_fn(|i| first.wrapping_add(i as u8)),
+            address,
             ..Self::default()
         }
     }
@@ -131,7 +139,7 @@ impl SpiTarget for Regs {
 impl I2cTarget for Regs {
     fn start(&mut self, address: u8, read: bool) -> bool {
         self.log.push(Event::Start(address, read));
-        let ack = address == Self::ADDRESS;
+        let ack = address == self.address;
         self.phase = match (ack, read) {
             (false, _) => Phase::Ignoring,
             (true, true) => Phase::Reading,

@@ -12,6 +12,9 @@
 //! - [`I2c`]: `embedded_hal::i2c::I2c` with START, repeated START between operations of
 //!   different direction, STOP at the end, and NACKs reported as
 //!   [`NoAcknowledge`](embedded_hal::i2c::ErrorKind::NoAcknowledge) of the address or the data;
+//! - [`I2cBus`]: several [`I2cTarget`]s on one bus, itself a target for [`I2c`]: every target
+//!   sees every START and STOP and answers its own addresses, the bytes go to those that
+//!   acknowledged, an address nobody acknowledges is NACKed;
 //! - [`Delay`] and [`Clock`]: a `DelayNs` that never sleeps but, if given a clock, advances it
 //!   (drivers wait during their initialisation; the emulation decides what time means).
 //!
@@ -51,6 +54,7 @@
 
 mod delay;
 mod i2c;
+mod i2c_bus;
 mod spi;
 
 #[cfg(test)]
@@ -58,6 +62,7 @@ mod fake;
 
 pub use delay::{Clock, Delay};
 pub use i2c::{I2c, I2cError};
+pub use i2c_bus::I2cBus;
 pub use spi::{ChipSelect, SpiBus, SpiDevice, SpiError};
 
 use std::cell::RefCell;
