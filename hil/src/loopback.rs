@@ -28,6 +28,9 @@ use std::time::{Duration, Instant};
 /// Samples the loopback device buffers (its credit window).
 pub const BUFFER: usize = 4096;
 
+/// Stack of the loopback device's thread.
+const DEVICE_THREAD_STACK: usize = 16 << 20;
+
 /// The loopback device: the firmware's link handler with a [`BUFFER`]-sample window.
 pub type Firmware = Device<BUFFER>;
 
@@ -114,6 +117,9 @@ where
     let flag = stop.clone();
     let thread = std::thread::Builder::new()
         .name("loopback-device".into())
+        // The device is built on the stack before it is boxed (and a reboot builds another):
+        // with its buffer of rig-sized images it is over half a MB.
+        .stack_size(DEVICE_THREAD_STACK)
         .spawn(move || {
             let mut hook = make_hook();
             let mut device: Box<Firmware> = Box::default();

@@ -88,6 +88,42 @@ fn magnetometers_alone_are_served_as_predicted_in_both_source_modes() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The fixture rig (an ICM-42688-P on SPI and an IST8310 on I2C): every rig image served as
+/// predicted; `sent.csv` names each device's image column, `meta.toml` lists the other device.
+#[test]
+fn rig_fixture_serves_every_devices_image_as_predicted() {
+    let (out, dir) = loopback(&fixture("rig.toml"), "rig", &[]);
+    assert!(
+        out.contains("1000 of 1000 predicted images confirmed byte for byte"),
+        "{out}"
+    );
+    let sent = std::fs::read_to_string(dir.join("sent.csv")).unwrap();
+    let mut lines = sent.lines();
+    assert_eq!(
+        lines.next(),
+        Some("index,t_ns,send_ns,late_ns,image.imu,image.compass,resend")
+    );
+    let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!((row[4].len(), row[5].len()), (64, 12), "{row:?}");
+    let meta = meta(&dir);
+    assert_eq!(meta["chip"]["name"].as_str(), Some("imu"));
+    let others = meta["other_devices"].as_array().unwrap();
+    assert_eq!(others.len(), 1);
+    assert_eq!(others[0]["model"].as_str(), Some("ist8310"));
+    assert_eq!(others[0]["name"].as_str(), Some("compass"));
+    // Source model cannot run a rig: refused before anything is sent, with the reason.
+    let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
+        .args(["loopback", "--source", "model", "--force", "-o"])
+        .arg(&dir)
+        .arg(fixture("rig.toml"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("a rig streams register images"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn chip_flag_swaps_the_chip_or_says_why_not() {
     let (out, dir) = loopback(&fixture("figure3.toml"), "swap", &["--chip", "icm20602"]);

@@ -13,6 +13,7 @@ fn error(text: &str) -> String {
 
 fn assert_error(text: &str, place: &str, reason: &str) {
     let e = error(text);
+
     assert!(
         e.starts_with(&format!("scenes/bad.toml:{place}: ")),
         "wrong place in: {e}"
@@ -250,6 +251,99 @@ fn magnetometer_chip_errors_are_located() {
         "its only bus"
     );
     assert_eq!(scene.chip.settings.mag_range_gauss(), Some(8.0));
+}
+
+#[test]
+fn rig_errors_are_located() {
+    let dev = |body: &str| format!("\n[[device]]\n{body}");
+    let imu = dev("name = \"imu\"\nmodel = \"icm42688p\"\n");
+    assert_error(
+        &format!("{BASE}{imu}{}", dev("model = \"ist8310\"\nbus = \"spi\"\n")),
+        "11:7",
+        "the IST8310 has no spi bus",
+    );
+    assert_error(
+        &format!(
+            "{BASE}{}{}",
+            dev("model = \"mpu6000\"\nbus = \"i2c\"\naddress = 0x68\n"),
+            dev("model = \"icm42688p\"\nbus = \"i2c\"\naddress = 0x68\n")
+        ),
+        "13:11",
+        "device `mpu6000` answers I2C at 0x68 already",
+    );
+    assert_error(
+        &format!(
+            "{BASE}{}{}",
+            dev("model = \"mpu9250\"\nbus = \"i2c\"\n"),
+            dev("model = \"ist8310\"\naddress = 0x0C\n")
+        ),
+        "11:11",
+        "device `mpu9250` answers I2C at 0x0c already",
+    );
+    assert_error(
+        &format!("{BASE}{imu}{}", dev("model = \"mpu6000\"\n")),
+        "9:1",
+        "chip select 0 is device `imu`'s already",
+    );
+    assert_error(
+        &format!(
+            "{BASE}{imu}{}",
+            dev("name = \"imu\"\nmodel = \"mpu6000\"\nchip_select = 1\n")
+        ),
+        "10:8",
+        "device `imu` has that name already",
+    );
+    assert_error(
+        &format!(
+            "{BASE}{imu}{}",
+            dev("name = \"a b\"\nmodel = \"ist8310\"\n")
+        ),
+        "10:8",
+        "\"a b\" is not a device name",
+    );
+    assert_error(
+        &format!("{BASE}[chip]\nmodel = \"mpu6000\"\n{imu}"),
+        "4:1",
+        "a scene lists its chips in [chip] or in [[device]], not both",
+    );
+    assert_error(
+        &format!("{BASE}{}", dev("model = \"mpu6000\"\nchip_select = 4\n")),
+        "7:15",
+        "chip select 4 is not one of 0..=3",
+    );
+    assert_error(
+        &format!("{BASE}{}", dev("model = \"ist8310\"\nchip_select = 1\n")),
+        "7:15",
+        "a chip select applies to bus = \"spi\" only",
+    );
+    assert_error(
+        &format!(
+            "{BASE}{}",
+            dev("model = \"mpu6000\"\noffset = [0.0, 0.0, 5.0]\n")
+        ),
+        "7:10",
+        "within ±1 m",
+    );
+    let five: String = (0..5)
+        .map(|i| {
+            dev(&format!(
+                "model = \"mpu6000\"\nchip_select = {}\nname = \"m{i}\"\n",
+                i % 4
+            ))
+        })
+        .collect();
+    let e = error(&format!("{BASE}{five}"));
+    assert!(e.contains("a rig has at most 4 devices"), "{e}");
+    // A rate of the IMU's but not the other IMU's: located at the rate.
+    assert_error(
+        &format!(
+            "duration = 1.0\nrate = 250.0\nseed = 1\n{}{}",
+            dev("model = \"mpu6000\"\n"),
+            dev("model = \"icm42688p\"\nchip_select = 1\n")
+        ),
+        "2:8",
+        "250 Hz is not an output rate of the ICM-42688-P",
+    );
 }
 
 #[test]

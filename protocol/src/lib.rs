@@ -21,4 +21,4 @@ pub mod regmap;
 pub use link::Error;
 
 /// Version of the link protocol spoken by this crate.
-pub const PROTOCOL_VERSION: u16 = 3;
+pub const PROTOCOL_VERSION: u16 = 4;

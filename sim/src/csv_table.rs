@@ -39,6 +39,11 @@ impl Table {
         self.header.iter().position(|h| h == name)
     }
 
+    /// The index of the first column whose name starts with `prefix`, or `None`.
+    pub fn first_with_prefix(&self, prefix: &str) -> Option<usize> {
+        self.header.iter().position(|h| h.starts_with(prefix))
+    }
+
     /// The index of column `name`, or an error listing the columns there are.
     pub fn column(&self, name: &str) -> Result<usize, ColumnError> {
         self.optional(name)

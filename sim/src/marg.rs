@@ -79,14 +79,18 @@ impl MargSim {
     /// axes) added to `[sensors.accel] lever_arm`. Device 0 is [`MargSim::new`]'s model when it
     /// has no offset. `None` if the scene has no such device.
     pub fn for_device(scene: &Scene, index: usize) -> Option<Result<Self, margemu_model::Error>> {
-        let device = scene.devices.get(index)?;
+        let device = scene.devices().into_iter().nth(index)?;
         let mut config = scene.spec.sensors.config();
         if let Some(offset) = device.chip.offset {
             let r = device.chip.to_chip(offset);
             let base = config.accel.lever_arm_m.unwrap_or([0.0; 3]);
             config.accel.lever_arm_m = Some([0, 1, 2].map(|i| base[i] + r[i]));
         }
-        Some(Self::build(scene, &config, device_seed(scene.spec.seed, index)))
+        Some(Self::build(
+            scene,
+            &config,
+            device_seed(scene.spec.seed, index),
+        ))
     }
 
     fn build(

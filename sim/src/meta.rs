@@ -131,8 +131,11 @@ pub struct SessionMeta {
     pub mag_ut_per_unit: f64,
     /// The temperature of images without one (°C).
     pub default_temp_c: f32,
-    /// `[chip]`.
+    /// `[chip]`: the chip, device 0 of a rig.
     pub chip: ChipMeta,
+    /// `[[other_devices]]`: a rig's further devices, in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub other_devices: Vec<ChipMeta>,
     /// `[image]`: the InvenSense 6xxx family's further conversion settings.
     pub image: Option<ImageMeta>,
     /// The scene text.
@@ -172,6 +175,15 @@ pub struct ChipMeta {
     pub mag_range_gauss: Option<f64>,
     /// The chip's mounting rotation, rows.
     pub rotation: Option<crate::scene::chip::Rotation>,
+    /// The device's name in the logs (`sent.csv`'s `image.NAME` column of a rig).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// SPI: the chip-select line.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chip_select: Option<u8>,
+    /// The lever arm, m, plate axes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset: Option<[f64; 3]>,
 }
 
 /// `[image]` of a session: the InvenSense 6xxx family's conversion settings (offsets, AK8963),

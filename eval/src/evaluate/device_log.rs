@@ -175,10 +175,16 @@ pub fn decode(image: &[u8], meta: &SessionMeta) -> Option<([f64; 3], [f64; 3])> 
     Some((r.acc, mag))
 }
 
-/// `sent.csv` decoded: `(t_ns, specific force, field)` per row.
+/// `sent.csv` decoded: `(t_ns, specific force, field)` per row. A rig's session has one
+/// `image.NAME` column per device: device 0's (the first) is decoded, with its own
+/// magnetometer only (a rig's external compass is not decoded here yet).
 pub fn read_sent(path: &Path, meta: &SessionMeta) -> Result<super::input::Imu, ColumnError> {
     let table = Table::open(path)?;
-    let [t, image] = table.columns(["t_ns", "image"])?;
+    let t = table.column("t_ns")?;
+    let image = match table.first_with_prefix("image.") {
+        Some(column) if table.optional("image").is_none() => column,
+        _ => table.column("image")?,
+    };
     let mut imu = super::input::Imu::default();
     table.for_each(|row| {
         let t_ns: u64 = row.int(t)?;

@@ -78,10 +78,10 @@ pub use ring::{Insert, SampleRing};
 use margemu_model::sensor::Truth;
 use margemu_protocol::link::{max_images_per_batch, ServedBatch, ServedSample, CRC32C};
 use margemu_protocol::link::{
-    Accumulator, AddDevice, Bus, Buses, Capabilities, Configure, Credit, DeviceState, Encoder, ErrorCode,
-    ErrorReport, FeedResult, FirmwareVersion, Frame, Hello, HelloAck, Image, Kind, Message, Modes,
-    Rate, RegisterWrite, RegisterWriteBatch, Reset, ResetCause, RxStats, SeqTracker, Source, Start,
-    Telemetry, DEVICE_ID_LEN, MAX_WIRE_LEN,
+    Accumulator, AddDevice, Bus, Buses, Capabilities, Configure, Credit, DeviceState, Encoder,
+    ErrorCode, ErrorReport, FeedResult, FirmwareVersion, Frame, Hello, HelloAck, Image, Kind,
+    Message, Modes, Rate, RegisterWrite, RegisterWriteBatch, Reset, ResetCause, RxStats,
+    SeqTracker, Source, Start, Telemetry, DEVICE_ID_LEN, MAX_WIRE_LEN,
 };
 use margemu_protocol::PROTOCOL_VERSION;
 

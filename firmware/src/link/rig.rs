@@ -1,5 +1,5 @@
 //! The chips a device serves at once: device 0, named by Configure, and the devices each
-//! [`AddDevice`] appends (`docs/spec/link.md` §5.4), up to [`MAX_DEVICES`].
+//! [`AddDevice`] appends (`docs/spec/link.md` §5.14), up to [`MAX_DEVICES`].
 //!
 //! A rig's image is every device's image in device order, back to back; [`Rig::latch_image_at`]
 //! hands each chip its slice at the same instant. Register writes are drained from every chip in

@@ -4,6 +4,7 @@
 mod common;
 mod fuzz_device;
 mod model;
+mod rig;
 mod robustness;
 mod session;
 mod streaming;

@@ -212,6 +212,9 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
         let cfg = self.session.configure_message();
         self.reports.expect_credit();
         self.send(&Message::Configure(cfg))?;
+        for add in self.session.add_device_messages() {
+            self.send(&Message::AddDevice(add))?;
+        }
         let timeout = self.plan.hello_timeout();
         let deadline = self.now() + timeout.as_nanos() as u64;
         while !self.reports.credit_seen() {

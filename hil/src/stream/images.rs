@@ -8,6 +8,11 @@
 //! or [`ImageSettings::default_temp_c`]) → the chip module's conversion with the explicit
 //! [`ImageSettings::chip`] register settings ([`ChipSettings::image`]).
 //!
+//! A rig (`[[device]]`) does this for every device, each with its own model
+//! ([`MargSim::for_device`]: its seed and lever arm), in its own axes, with its own settings
+//! (the first device's are [`ImageSettings::chip`]), and the sample's image is every device's
+//! image in device order, back to back: what the link carries.
+//!
 //! ```
 //! use margemu_sim::scene::Scene;
 //! use margemu_hil::stream::{predict_images, ImageSettings};
@@ -77,28 +82,47 @@ pub struct PredictedSample {
 pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<PredictedSample> {
     let (scene, settings) = (scene.clone(), *settings);
     Predictions::spawn(move |emit| {
-        let mut marg = MargSim::new(&scene).map_err(margemu_sim::run::RunError::Model)?;
+        let mut devices = Vec::new();
+        for (i, device) in scene.devices().into_iter().enumerate() {
+            let marg = MargSim::for_device(&scene, i)
+                .unwrap_or_else(|| MargSim::new(&scene))
+                .map_err(margemu_sim::run::RunError::Model)?;
+            let chip_settings = if i == 0 {
+                settings.chip
+            } else {
+                device.chip.settings
+            };
+            devices.push((marg, device.chip, chip_settings));
+        }
         let temperature = scene.spec.sensors.temperature;
         run_scene(&scene, |truth| {
-            let s = marg
-                .try_sample(&scene, &in_chip_axes(truth, &scene.chip))
-                .map_err(|e| Halt::Failed(margemu_sim::run::RunError::NonFinite(e)))?
-                .sample;
             // Same expression as `MargSim`, so the temperature the model sees is the one sent.
             let temp_c = temperature.map_or(settings.default_temp_c, |[start, slope]| {
                 (start + slope * truth.t_ns as f64 * 1e-9) as f32
             });
-            let sample = PhysicalSample {
-                acc: s.acc,
-                gyr: s.gyr,
-                mag: s
-                    .mag
-                    .map(|v| (f64::from(v) * settings.mag_ut_per_unit) as f32),
-                temp_c,
-            };
+            let mut image = [0u8; margemu_protocol::chip::MAX_IMAGE_LEN];
+            let mut len = 0;
+            for (marg, chip, chip_settings) in &mut devices {
+                let s = marg
+                    .try_sample(&scene, &in_chip_axes(truth, chip))
+                    .map_err(|e| Halt::Failed(margemu_sim::run::RunError::NonFinite(e)))?
+                    .sample;
+                let sample = PhysicalSample {
+                    acc: s.acc,
+                    gyr: s.gyr,
+                    mag: s
+                        .mag
+                        .map(|v| (f64::from(v) * settings.mag_ut_per_unit) as f32),
+                    temp_c,
+                };
+                let one = chip_settings.image(&sample);
+                let end = (len + one.len()).min(image.len());
+                image[len..end].copy_from_slice(&one[..end - len]);
+                len = end;
+            }
             Ok(emit(PredictedSample {
                 truth: *truth,
-                image: settings.chip.image(&sample),
+                image: Image::new(&image[..len]).unwrap_or_default(),
             })?)
         })
     })

@@ -54,8 +54,35 @@ pub const SESSION_FILES: [&str; 7] = [
     EVENTS_FILE,
 ];
 
-/// Header of `sent.csv` in source mode images.
+/// Header of `sent.csv` in source mode images, for one chip.
 pub const SENT_COLUMNS: &str = "index,t_ns,send_ns,late_ns,image,resend";
+
+/// What `sent.csv` holds: the source mode's items.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SentLayout {
+    /// Register images: one chip (`image`), or a rig's devices, each `(name, image length)`,
+    /// one `image.NAME` column each, in device order.
+    Images(Vec<(String, usize)>),
+    /// Kinematics for the device's model.
+    Kinematics,
+}
+
+impl SentLayout {
+    /// The header line.
+    pub fn columns(&self) -> String {
+        match self {
+            Self::Images(devices) if devices.len() > 1 => {
+                let images: Vec<String> = devices
+                    .iter()
+                    .map(|(name, _)| format!("image.{name}"))
+                    .collect();
+                format!("index,t_ns,send_ns,late_ns,{},resend", images.join(","))
+            }
+            Self::Images(_) => SENT_COLUMNS.to_owned(),
+            Self::Kinematics => SENT_KINEMATICS_COLUMNS.to_owned(),
+        }
+    }
+}
 /// Header of `sent.csv` in source mode model.
 pub const SENT_KINEMATICS_COLUMNS: &str =
     "index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend";
@@ -83,6 +110,8 @@ pub struct SessionLog {
     register_writes: BufWriter<File>,
     events: BufWriter<File>,
     truth: TruthWriter<BufWriter<File>>,
+    /// A rig's image lengths, one `sent.csv` column each (empty: one column).
+    image_split: Vec<usize>,
 }
 
 fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
@@ -92,15 +121,21 @@ fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
 }
 
 impl SessionLog {
-    /// Creates `dir` and every file, with their headers (`sent_columns`: the
-    /// source mode's), and writes `meta.toml`.
-    pub fn create(dir: &Path, meta: &SessionMeta, sent_columns: &str) -> io::Result<Self> {
+    /// Creates `dir` and every file, with their headers (`sent`: what `sent.csv` holds), and
+    /// writes `meta.toml`.
+    pub fn create(dir: &Path, meta: &SessionMeta, sent: &SentLayout) -> io::Result<Self> {
+        let image_split = match sent {
+            SentLayout::Images(devices) if devices.len() > 1 => {
+                devices.iter().map(|(_, len)| *len).collect()
+            }
+            _ => Vec::new(),
+        };
         std::fs::create_dir_all(dir)?;
         margemu_sim::meta::write(dir, meta)?;
         let mut log = Self {
             dir: dir.to_path_buf(),
             float: ryu::Buffer::new(),
-            sent: create(dir, SENT_FILE, sent_columns)?,
+            sent: create(dir, SENT_FILE, &sent.columns())?,
             served: create(dir, SERVED_FILE, SERVED_COLUMNS)?,
             device: create(dir, DEVICE_FILE, DEVICE_COLUMNS)?,
             telemetry: create(dir, TELEMETRY_FILE, TELEMETRY_COLUMNS)?,
@@ -110,6 +145,7 @@ impl SessionLog {
                 1 << 16,
                 File::create(dir.join(TRUTH_FILE))?,
             ))?,
+            image_split,
         };
         log.flush()?;
         Ok(log)
@@ -141,7 +177,19 @@ impl SessionLog {
         resend: bool,
     ) -> io::Result<()> {
         self.sent_times(index, t_ns, send_ns, late_ns)?;
-        writeln!(self.sent, ",{image:x},{}", u8::from(resend))
+        let mut rest: &[u8] = image;
+        for len in &self.image_split {
+            let (device, others) = rest.split_at((*len).min(rest.len()));
+            self.sent.write_all(b",")?;
+            device
+                .iter()
+                .try_for_each(|b| write!(self.sent, "{b:02x}"))?;
+            rest = others;
+        }
+        if self.image_split.is_empty() {
+            write!(self.sent, ",{image:x}")?;
+        }
+        writeln!(self.sent, ",{}", u8::from(resend))
     }
 
     /// One row of `sent.csv` in source mode model.

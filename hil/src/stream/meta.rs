@@ -4,11 +4,11 @@
 
 use super::images::ImageSettings;
 use super::session::StreamConfig;
-use margemu_protocol::chip::Conversion;
+use margemu_protocol::chip::{ChipSettings, Conversion};
 use margemu_protocol::link::{HelloAck, Rate};
 use margemu_protocol::PROTOCOL_VERSION;
 use margemu_sim::meta::{ChipMeta, DeviceMeta, ImageMeta, SessionMeta};
-use margemu_sim::scene::chip::ChipSetup;
+use margemu_sim::scene::chip::{BusKind, ChipSetup};
 use margemu_sim::scene::Scene;
 
 /// `meta.toml`; `hold` is the kinematics hold of source mode model (`None`: images).
@@ -42,7 +42,18 @@ pub(super) fn metadata(
         field_unit: scene.spec.field.unit.symbol().to_string(),
         mag_ut_per_unit: s.mag_ut_per_unit,
         default_temp_c: s.default_temp_c,
-        chip: chip_meta(&scene.chip, s),
+        chip: ChipMeta {
+            name: Some(scene.chip_name.clone()),
+            ..chip_meta(&scene.chip, &s.chip)
+        },
+        other_devices: scene
+            .other_devices
+            .iter()
+            .map(|d| ChipMeta {
+                name: Some(d.name.clone()),
+                ..chip_meta(&d.chip, &d.chip.settings)
+            })
+            .collect(),
         image: match &s.chip.conversion {
             Conversion::Mpu6xxx(i) => Some(ImageMeta {
                 accel_fs: format!("{:?}", i.accel_fs),
@@ -62,18 +73,22 @@ pub(super) fn metadata(
     }
 }
 
-fn chip_meta(chip: &ChipSetup, s: &ImageSettings) -> ChipMeta {
-    let fs = s.chip.full_scale();
+/// `chip`'s table, its images computed with `settings`.
+fn chip_meta(chip: &ChipSetup, settings: &ChipSettings) -> ChipMeta {
+    let fs = settings.full_scale();
     ChipMeta {
-        model: s.chip.model.name().to_string(),
+        model: settings.model.name().to_string(),
         who_am_i: chip.who_am_i,
         bus: chip.bus.name().to_string(),
         i2c_address: chip.i2c_address,
-        image_len: s.chip.model.image_len(),
+        image_len: settings.model.image_len(),
         accel_range_g: fs.map(|fs| fs.accel_g),
         gyro_range_dps: fs.map(|fs| fs.gyro_dps),
-        mag_range_gauss: s.chip.mag_range_gauss(),
+        mag_range_gauss: settings.mag_range_gauss(),
         rotation: chip.rotation,
+        name: None,
+        chip_select: (chip.bus == BusKind::Spi).then_some(chip.chip_select),
+        offset: chip.offset,
     }
 }
 

@@ -85,6 +85,13 @@ pub fn predict_model(
     settings: &ImageSettings,
     kinematics_hz: Option<f64>,
 ) -> Result<ModelPrediction, StreamError> {
+    if scene.is_rig() {
+        return Err(StreamError::Model {
+            reason: "the scene is a rig of several [[device]]s: a rig streams register images \
+                     (source images), each device's model running on the host"
+                .into(),
+        });
+    }
     if scene.spec.perturbation.is_some() {
         return Err(StreamError::Model {
             reason: "the scene has a [perturbation]: the device cannot run the perturbation \

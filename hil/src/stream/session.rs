@@ -6,7 +6,7 @@
 use super::clock::SystemClock;
 use super::flow::Run;
 use super::images::{predict_images, ImageSettings};
-use super::log::{SessionLog, SENT_COLUMNS, SENT_KINEMATICS_COLUMNS};
+use super::log::{SentLayout, SessionLog};
 use super::logger::Logger;
 use super::meta::metadata;
 use super::model::predict_model;
@@ -138,13 +138,21 @@ impl Session {
             path: dir.to_path_buf(),
             source,
         };
-        let sent_columns = match items {
-            Items::Images => SENT_COLUMNS,
-            Items::Kinematics { .. } => SENT_KINEMATICS_COLUMNS,
+        let sent = match items {
+            Items::Images => SentLayout::Images(
+                scene
+                    .devices()
+                    .into_iter()
+                    .map(|d| (d.name, d.chip.model.image_len()))
+                    .collect(),
+            ),
+            Items::Kinematics { .. } => SentLayout::Kinematics,
         };
-        let log = SessionLog::create(dir, &meta, sent_columns).map_err(log_err)?;
+        let log = SessionLog::create(dir, &meta, &sent).map_err(log_err)?;
         let log = Logger::spawn(log).map_err(log_err)?;
-        let source = Source::new(items, prediction, scene.chip, rate, scene.samples());
+        let others = scene.other_devices.iter().map(|d| d.chip).collect();
+        let chips = (scene.chip, others);
+        let source = Source::new(items, prediction, chips, rate, scene.samples());
         Ok(Self {
             config,
             settings,
@@ -207,6 +215,11 @@ impl Session {
     }
 
     /// Configure for this session.
+    /// One AddDevice per other device of a rig, to follow Configure.
+    pub(super) fn add_device_messages(&self) -> Vec<margemu_protocol::link::AddDevice> {
+        self.source.add_device_messages()
+    }
+
     pub(super) fn configure_message(&self) -> Configure {
         let period = self.config.telemetry_period.as_nanos() as u64;
         self.source.configure_message(period)

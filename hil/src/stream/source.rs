@@ -23,7 +23,7 @@ use super::window::Window;
 use super::{ModelSample, StreamError};
 use margemu_model::sensor;
 use margemu_protocol::link::{
-    self, max_images_per_batch, Capabilities, Configure, Encoder, Image, ImageBatch,
+    self, max_images_per_batch, AddDevice, Capabilities, Configure, Encoder, Image, ImageBatch,
     KinematicsBatch, Message, ModelParams, Modes, Rate, CRC32C, MAX_KINEMATICS_PER_BATCH,
     TRUTH_LEN,
 };
@@ -111,8 +111,10 @@ impl Prediction {
 pub(super) struct Source {
     items: Items,
     prediction: Prediction,
-    /// The chip Configure asks for (the scene's `[chip]`).
+    /// The chip Configure asks for (the scene's `[chip]`, device 0 of a rig).
     chip: ChipSetup,
+    /// The rig's other devices, one AddDevice each after Configure.
+    others: Vec<ChipSetup>,
     /// The scene's output rate.
     rate: Rate,
     /// Output samples in the scene.
@@ -120,12 +122,12 @@ pub(super) struct Source {
 }
 
 impl Source {
-    /// The `items` of a scene of `samples` output samples at `rate` for `chip`, read from
-    /// `prediction`.
+    /// The `items` of a scene of `samples` output samples at `rate` for `chip` (and a rig's
+    /// `others`), read from `prediction`.
     pub(super) fn new(
         items: Items,
         prediction: Prediction,
-        chip: ChipSetup,
+        (chip, others): (ChipSetup, Vec<ChipSetup>),
         rate: Rate,
         samples: u64,
     ) -> Self {
@@ -133,9 +135,16 @@ impl Source {
             items,
             prediction,
             chip,
+            others,
             rate,
             samples,
         }
+    }
+
+    /// Bytes of one sample's image: the chip's, or a rig's devices' summed.
+    fn image_len(&self) -> usize {
+        let others: usize = self.others.iter().map(|c| c.model.image_len()).sum();
+        self.chip.model.image_len() + others
     }
 
     /// Output samples in the scene.
@@ -237,7 +246,7 @@ impl Source {
     /// Bytes of one item on the wire (before framing).
     pub(super) fn item_len(&self) -> u64 {
         match &self.items {
-            Items::Images => self.chip.model.image_len() as u64,
+            Items::Images => self.image_len() as u64,
             Items::Kinematics { .. } => TRUTH_LEN as u64,
         }
     }
@@ -245,7 +254,7 @@ impl Source {
     /// Most items in one frame.
     pub(super) fn max_per_frame(&self) -> usize {
         match &self.items {
-            Items::Images => max_images_per_batch(self.chip.model.image_len()),
+            Items::Images => max_images_per_batch(self.image_len()),
             Items::Kinematics { .. } => MAX_KINEMATICS_PER_BATCH,
         }
     }
@@ -265,9 +274,9 @@ impl Source {
     /// must emulate the chip, support the source mode, and have batch and buffer space.
     pub(super) fn refusal(&self, caps: &Capabilities) -> Option<String> {
         let (mode, no_mode) = self.required_mode();
-        let model = self.chip.model;
-        if !caps.chips.has(model) {
-            Some(format!("it does not emulate the {}", model.part_name()))
+        let models = std::iter::once(&self.chip).chain(&self.others);
+        if let Some(c) = models.into_iter().find(|c| !caps.chips.has(c.model)) {
+            Some(format!("it does not emulate the {}", c.model.part_name()))
         } else if !caps.modes.contains(mode) {
             Some(no_mode.to_owned())
         } else if caps.max_batch == 0 || caps.buffer_capacity == 0 {
@@ -288,6 +297,14 @@ impl Source {
             source,
             ..self.chip.configure(self.rate)
         }
+    }
+
+    /// One AddDevice per other device of a rig, in device order, to follow Configure.
+    pub(super) fn add_device_messages(&self) -> Vec<AddDevice> {
+        self.others
+            .iter()
+            .map(|c| c.add_device(self.rate))
+            .collect()
     }
 
     /// Encodes the batch of items `first .. first + n` into `wire`; returns its length.

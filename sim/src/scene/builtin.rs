@@ -39,6 +39,7 @@ builtins!(
     "gimbal-lock",
     "icm42688p",
     "mpu6000",
+    "rig",
     "static"
 );
 

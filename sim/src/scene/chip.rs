@@ -23,7 +23,7 @@
 
 use super::error::Violation;
 use margemu_protocol::chip::{ChipModel, ChipSettings, FullScale, SettingsError};
-use margemu_protocol::link::{Configure, Rate, RegisterOverride};
+use margemu_protocol::link::{AddDevice, Configure, DeviceBus, Rate, RegisterOverride};
 use serde::Deserialize;
 
 /// Chip-select lines a scene may name (a board's SPI target has at most this many).
@@ -143,15 +143,39 @@ impl ChipSetup {
             i2c_address: self.i2c_address,
             ..Configure::new(self.model, rate)
         };
-        for (file, register, value) in self.settings.config_writes(rate.as_hz_f64()) {
-            // At most two writes: always within MAX_OVERRIDES.
-            let _ = cfg.overrides.push(RegisterOverride {
+        // At most two writes: always within MAX_OVERRIDES.
+        cfg.overrides.extend(self.overrides(rate));
+        cfg
+    }
+
+    /// The AddDevice of this chip as a further device of a rig running at `rate`: its
+    /// identity, address or chip select, and the overrides Configure would carry.
+    pub fn add_device(&self, rate: Rate) -> AddDevice {
+        let bus = match self.bus {
+            BusKind::Spi => DeviceBus::Spi,
+            BusKind::I2c => DeviceBus::I2c,
+        };
+        let mut add = AddDevice {
+            who_am_i: self.who_am_i,
+            i2c_address: self.i2c_address,
+            chip_select: self.chip_select,
+            ..AddDevice::new(self.model, bus)
+        };
+        // The same writes as Configure's (at most two): within MAX_DEVICE_OVERRIDES.
+        add.overrides.extend(self.overrides(rate));
+        add
+    }
+
+    /// The register overrides that set this chip's ranges (and, with `rate`, the output rate
+    /// where one register holds both): what Configure and AddDevice carry.
+    fn overrides(&self, rate: Rate) -> impl Iterator<Item = RegisterOverride> {
+        self.settings
+            .config_writes(rate.as_hz_f64())
+            .map(|(file, register, value)| RegisterOverride {
                 file,
                 register,
                 value,
-            });
-        }
-        cfg
+            })
     }
 
     /// `v` (plate axes) in the chip's axes.
@@ -177,6 +201,9 @@ pub fn with_model(scene: &super::Scene, name: &str) -> Result<super::Scene, Stri
         ));
     }
     let mut scene = scene.clone();
+    if scene.chip_name == scene.chip.model.name() {
+        scene.chip_name = model.name().to_owned();
+    }
     scene.chip = ChipSetup {
         rotation: scene.chip.rotation,
         ..ChipSetup::power_on(model)
@@ -343,7 +370,10 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
         (BusKind::Spi, Some(cs)) => {
             return Err(Violation::at(
                 &["chip", "chip_select"],
-                format!("chip select {cs} is not one of 0..={}", MAX_CHIP_SELECTS - 1),
+                format!(
+                    "chip select {cs} is not one of 0..={}",
+                    MAX_CHIP_SELECTS - 1
+                ),
             ))
         }
         (BusKind::I2c, Some(_)) => {
@@ -354,7 +384,10 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
         }
     };
     if let Some(offset) = spec.offset {
-        if offset.iter().any(|x| !x.is_finite() || x.abs() > MAX_OFFSET_M) {
+        if offset
+            .iter()
+            .any(|x| !x.is_finite() || x.abs() > MAX_OFFSET_M)
+        {
             return Err(Violation::at(
                 &["chip", "offset"],
                 format!("each coordinate must be finite and within ±{MAX_OFFSET_M} m"),

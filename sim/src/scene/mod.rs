@@ -53,11 +53,13 @@ pub struct Scene {
     pub duration_ns: Nanos,
     /// Integrator sub-step in nanoseconds.
     pub step_ns: Nanos,
-    /// The primary chip: `[chip]`, the first `[[device]]`, or the default MPU-9250.
+    /// The primary chip, device 0 of the rig: `[chip]`, the first `[[device]]`, or the default
+    /// MPU-9250.
     pub chip: chip::ChipSetup,
-    /// Every device the scene's rig serves, the primary first ([`rig`]); one for a scene with
-    /// `[chip]` or none.
-    pub devices: Vec<rig::Device>,
+    /// Device 0's name in the logs.
+    pub chip_name: String,
+    /// The rig's other devices (`[[device]]` after the first), in order ([`rig`]).
+    pub other_devices: Vec<rig::Device>,
     /// Legal but likely wrong inputs, located (commands print them once, to stderr).
     pub warnings: Vec<SceneWarning>,
 }
@@ -90,12 +92,29 @@ impl Scene {
             clock: checked.clock,
             duration_ns: checked.duration_ns,
             step_ns: checked.step_ns,
-            chip: checked.devices.first().map(|d| d.chip).unwrap_or_default(),
-            devices: checked.devices,
+            chip: checked.primary.chip,
+            chip_name: checked.primary.name,
+            other_devices: checked.others,
             warnings,
         };
         scene.check_gains()?;
         Ok(scene)
+    }
+
+    /// Every device of the scene's rig, device 0 ([`Scene::chip`]) first.
+    pub fn devices(&self) -> Vec<rig::Device> {
+        let primary = rig::Device {
+            name: self.chip_name.clone(),
+            chip: self.chip,
+        };
+        std::iter::once(primary)
+            .chain(self.other_devices.iter().cloned())
+            .collect()
+    }
+
+    /// Whether the scene serves several devices at once.
+    pub fn is_rig(&self) -> bool {
+        !self.other_devices.is_empty()
     }
 
     /// The PID gains a bench scene derives (or gives) must be finite; they are refused at the

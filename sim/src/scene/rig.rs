@@ -20,7 +20,8 @@
 //! Each `[[device]]` takes every key of `[chip]` (the model, bus, address or chip select,
 //! identity, mounting rotation and lever arm, ranges, name). A scene names its chips either in
 //! `[chip]` (one device) or in `[[device]]` (one to [`MAX_DEVICES`]), not both; without either it
-//! has the MPU-9250 at power-on. The first device is the scene's primary chip ([`super::Scene::chip`]).
+//! has the MPU-9250 at power-on. The first device is the scene's primary chip
+//! ([`super::Scene::chip`]); [`super::Scene::devices`] lists them all.
 //!
 //! Checked across devices, each refusal located at the offending key: names unique (a name
 //! is the device's column in the logs: letters, digits, `_` and `-`), no two I2C devices
@@ -32,7 +33,7 @@
 //! let text = "duration = 1.0\nrate = 1000.0\nseed = 1\n\
 //!     [[device]]\nmodel = \"icm42688p\"\n[[device]]\nmodel = \"ist8310\"\n";
 //! let scene = margemu_sim::scene::Scene::parse_str(text, std::path::Path::new("rig.toml")).unwrap();
-//! let names: Vec<_> = scene.devices.iter().map(|d| d.name.as_str()).collect();
+//! let names: Vec<_> = scene.devices().into_iter().map(|d| d.name).collect();
 //! assert_eq!(names, ["icm42688p", "ist8310"]);
 //! ```
 
@@ -50,8 +51,21 @@ pub struct Device {
     pub chip: ChipSetup,
 }
 
-/// The devices of a scene: `[chip]` or `[[device]]` (absent: the default MPU-9250).
+/// The devices of a scene, device 0 and the others: `[chip]` or `[[device]]` (absent: the
+/// default MPU-9250).
 pub(crate) fn resolve(
+    chip: Option<&ChipSpec>,
+    devices: &[ChipSpec],
+    rate: f64,
+) -> Result<(Device, Vec<Device>), Violation> {
+    let mut rig = resolve_all(chip, devices, rate)?.into_iter();
+    let primary = rig
+        .next()
+        .ok_or_else(|| Violation::at(&["device"], "no device"))?;
+    Ok((primary, rig.collect()))
+}
+
+fn resolve_all(
     chip: Option<&ChipSpec>,
     devices: &[ChipSpec],
     rate: f64,
@@ -93,13 +107,19 @@ pub(crate) fn resolve(
             let key = if spec.name.is_some() { "name" } else { "model" };
             return Err(Violation::at_path(
                 at(key),
-                format!("device `{}` has that name already: give each device a `name`", other.name),
+                format!(
+                    "device `{}` has that name already: give each device a `name`",
+                    other.name
+                ),
             ));
         }
         if let Some((other, address)) = i2c_clash(&rig, &setup) {
             return Err(Violation::at_path(
                 at("address"),
-                format!("device `{other}` answers I2C at {} already", hexes(&[address])),
+                format!(
+                    "device `{other}` answers I2C at {} already",
+                    hexes(&[address])
+                ),
             ));
         }
         if let Some(other) = spi_clash(&rig, &setup) {

@@ -11,7 +11,8 @@ pub(crate) struct Checked {
     pub clock: SampleClock,
     pub duration_ns: Nanos,
     pub step_ns: Nanos,
-    pub devices: Vec<super::rig::Device>,
+    pub primary: super::rig::Device,
+    pub others: Vec<super::rig::Device>,
     /// Legal but likely wrong inputs.
     pub warnings: Vec<Violation>,
 }
@@ -50,12 +51,13 @@ pub(crate) fn check(spec: &SceneSpec) -> Result<Checked, Violation> {
         check_joint(name, source, spec.motion)?;
     }
     check_sensors(spec)?;
-    let devices = super::rig::resolve(spec.chip.as_ref(), &spec.device, spec.rate)?;
+    let (primary, others) = super::rig::resolve(spec.chip.as_ref(), &spec.device, spec.rate)?;
     Ok(Checked {
         clock,
         duration_ns,
         step_ns,
-        devices,
+        primary,
+        others,
         warnings: super::warnings::collect(spec),
     })
 }

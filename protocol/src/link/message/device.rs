@@ -1,5 +1,5 @@
 //! [`AddDevice`]: one more chip for a rig, served beside the one [`Configure`](super::Configure)
-//! names (`docs/spec/link.md` §5.4).
+//! names (`docs/spec/link.md` §5.14).
 //!
 //! Configure describes device 0 and drops any other; each AddDevice that follows (before
 //! Start, in source (a)) appends the next device, up to [`MAX_DEVICES`] in all. From then on
