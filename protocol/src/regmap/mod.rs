@@ -13,7 +13,8 @@
 //!   configuration upload's registers and the conversions (little-endian data, temperature,
 //!   sensor time);
 //! - [`ist8310`]: the iSentek IST8310 standalone I2C magnetometer;
-//! - [`qmc5883l`]: the QST QMC5883L standalone I2C magnetometer.
+//! - [`qmc5883l`]: the QST QMC5883L standalone I2C magnetometer;
+//! - [`rm3100`]: the PNI RM3100 magneto-inductive magnetometer (I2C or SPI, 24-bit results).
 //!
 //! Both the firmware (which serves these values) and the host (which predicts what a driver
 //! reads) call the same functions, so they agree bit for bit.
@@ -30,5 +31,6 @@ pub mod icm42688p;
 pub mod ist8310;
 pub mod mpu6xxx;
 pub mod qmc5883l;
+pub mod rm3100;
 
 pub use mpu6xxx::image::IMAGE_LEN;
