@@ -30,7 +30,9 @@
 //!   configuration upload, data registers and sensor time); not yet one of the [`EmulatedChip`]s.
 //! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer, as an [`I2cTarget`] (not yet an
 //!   [`EmulatedChip`]);
-//! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer, likewise an [`I2cTarget`] only.
+//! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer, likewise an [`I2cTarget`] only;
+//! - [`Rm3100`]: the PNI RM3100 magnetometer, as an [`I2cTarget`] and an [`SpiTarget`] (not yet
+//!   an [`EmulatedChip`]).
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
@@ -41,6 +43,7 @@ pub mod icm42688p;
 pub mod ist8310;
 pub mod mpu6xxx;
 pub mod qmc5883l;
+pub mod rm3100;
 mod spi_phase;
 mod write_log;
 
@@ -50,6 +53,7 @@ pub use icm42688p::Icm42688p;
 pub use ist8310::Ist8310;
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
 pub use qmc5883l::Qmc5883l;
+pub use rm3100::Rm3100;
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 
 /// The SPI target side of a chip (mode 0/3, MSB first), byte by byte.
