@@ -82,7 +82,7 @@ impl Rm3100 {
                 Run::SelfTest { done_at, axes } => {
                     if done_at <= limit {
                         self.bist_ok = (axes << 4) & bits::BIST_OK;
-                        self.drdy = true;
+                        self.drdy = true; // the results stay as they were
                         self.run = Run::Idle;
                     }
                     return;
@@ -98,7 +98,7 @@ impl Rm3100 {
                     self.latch_axis(axis, &seq);
                     seq.done |= 1 << axis;
                     self.run = if seq.complete() {
-                        self.drdy = true;
+                        self.publish();
                         Run::Idle
                     } else {
                         Run::Single(seq)
@@ -121,7 +121,7 @@ impl Rm3100 {
                     self.latch_axis(axis, &seq);
                     seq.done |= 1 << axis;
                     if seq.complete() || self.cmm & bits::CMM_DRDM != 0 {
-                        self.drdy = true;
+                        self.publish();
                     }
                     if seq.complete() {
                         let next = seq.later(1, period);
@@ -183,16 +183,24 @@ impl Rm3100 {
         }
     }
 
-    /// Converts the held field on `axis` into its three result bytes.
+    /// Converts the held field on `axis` into its three result bytes, kept until [`Self::publish`].
     fn latch_axis(&mut self, axis: usize, seq: &Sequence) {
         let field = self.field_ut.get(axis).copied().unwrap_or(0.0);
         let cc = seq.cycle_counts.get(axis).copied().unwrap_or(0);
         let bytes = map::data_bytes(map::axis_to_raw(field, cc));
-        if let Some(slot) = self.data.get_mut(3 * axis..3 * axis + 3) {
+        if let Some(slot) = self.pending.get_mut(3 * axis..3 * axis + 3) {
             for (d, b) in slot.iter_mut().zip(bytes) {
                 *d = b;
             }
         }
+    }
+}
+
+impl Rm3100 {
+    /// The measured axes reach the result registers together, and DRDY rises.
+    fn publish(&mut self) {
+        self.data = self.pending;
+        self.drdy = true;
     }
 }
 

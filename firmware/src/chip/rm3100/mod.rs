@@ -10,9 +10,11 @@
 //!
 //! **Measurements** (DS §5.2, §5.3). The axes of a measurement are measured one after the other,
 //! each taking [`axis_measurement_ns`](margemu_protocol::regmap::rm3100::axis_measurement_ns) of
-//! its own cycle count (2.28 ms at the default 200), and each axis's three result bytes are
-//! latched when that axis completes, at a gain of 0.375 LSB/µT per cycle count. A write to POLL
-//! with axis bits starts a single measurement: STATUS.DRDY rises when all requested axes are done.
+//! its own cycle count (2.28 ms at the default 200) and converting the field held when it
+//! completes, at a gain of 0.375 LSB/µT per cycle count. The result registers take the new values
+//! when DRDY rises, all measured axes at once, so a read never mixes two measurements
+//! (assumption: the DS does not say when each axis's registers change). A write to POLL with
+//! axis bits starts a single measurement: DRDY rises when all requested axes are done.
 //! CMM with START and axis bits runs measurements every
 //! [`continuous_period_ns`](margemu_protocol::regmap::rm3100::continuous_period_ns) (the TMRC
 //! period, or the measurement itself when that is longer), the first starting at the write;
@@ -97,6 +99,8 @@ pub struct Rm3100 {
     nack: u8,
     drdy: bool,
     data: [u8; 9],
+    /// Axes measured in the current sequence, not yet in `data`.
+    pending: [u8; 9],
     run: Run,
     now_ns: u64,
     field_ut: [f32; 3],
@@ -136,6 +140,7 @@ impl Rm3100 {
             nack: reset::HSHAKE & (bits::HSHAKE_NACK0 | bits::HSHAKE_NACK1 | bits::HSHAKE_NACK2),
             drdy: false,
             data: [0; 9],
+            pending: [0; 9],
             run: Run::Idle,
             now_ns: 0,
             field_ut: [0.0; 3],
