@@ -117,11 +117,7 @@ fn every_reading_is_the_latest_sample_in_order() {
             let k = k.expect("a sequence completed before every call");
             assert!(last < Some(k), "{link:?} call {i}: in order");
             last = Some(k);
-            assert!(
-                within_one_lsb(*raw, fields[k], [200; 3]),
-                "{link:?} call {i}: {raw:?} vs sample {k} {:?}",
-                fields[k]
-            );
+            assert_sample(*raw, &fields, k, format!("{link:?} call {i}"));
         }
         assert_eq!(ap.rewrites, 0, "{link:?}: every checked register read back");
     }

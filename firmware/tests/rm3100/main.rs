@@ -89,6 +89,21 @@ pub fn within_one_lsb(raw: [i32; 3], want: [f32; 3], cycle_counts: [u16; 3]) -> 
     })
 }
 
+/// Asserts that `raw` is sample `k` of `fields` within one LSB at 200 cycle counts.
+#[track_caller]
+pub fn assert_sample(
+    raw: [i32; 3],
+    fields: &[[f32; 3]],
+    k: usize,
+    context: impl core::fmt::Display,
+) {
+    assert!(
+        within_one_lsb(raw, fields[k], [200; 3]),
+        "{context}: {raw:?} vs sample {k} {:?}",
+        fields[k]
+    );
+}
+
 /// A field sequence (µT, chip axes) sweeping every axis through both signs, inside ±800 µT.
 pub fn samples(n: usize) -> Vec<[f32; 3]> {
     (0..n)
