@@ -69,9 +69,8 @@ impl ArduPilot {
     }
 }
 
-/// Runs ArduPilot for `calls` timer calls from `T_CFG`, the device latching sample k 1 µs after
-/// the chip's k-th measurement sequence starts (its z axis of the sequence before completes at
-/// the start). Returns the driver and, for each call, the sample
+/// Runs ArduPilot for `calls` timer calls from `T_CFG`, the device latching the [`samples`] as
+/// [`Bench`] does. Returns the driver and, for each call, the sample
 /// the chip's last completed sequence measured (if any).
 fn run(link: Link, strict: bool, calls: u64) -> (ArduPilot, Vec<Option<usize>>) {
     const T_CFG: u64 = MS;
@@ -82,19 +81,11 @@ fn run(link: Link, strict: bool, calls: u64) -> (ArduPilot, Vec<Option<usize>>) 
     // 3 axes at 200 counts (6.85 ms) are slower than TMRC 0x94 (6.67 ms): back to back.
     let period = continuous_period_ns(0x94, 0b111, [200; 3]);
     assert_eq!(period, MEAS_3X200);
-    let fields = samples(1 + (calls * TIMER_NS / period) as usize);
-    let mut latched = 0;
+    let mut bench = Bench::new(T_CFG, period, T_CFG + calls * TIMER_NS);
     let mut expected = Vec::new();
     for j in 1..=calls {
         let t = T_CFG + j * TIMER_NS;
-        while T_CFG + latched as u64 * period + US <= t {
-            mag.latch_at(
-                &field(fields[latched]),
-                T_CFG + latched as u64 * period + US,
-            );
-            latched += 1;
-        }
-        mag.advance(t);
+        bench.run_to(&mut mag, t);
         // Sequence k completes at T_CFG + (k + 1) · period.
         expected.push(((t - T_CFG) / period).checked_sub(1).map(|k| k as usize));
         ap.timer(&mut mag);

@@ -96,8 +96,8 @@ impl Px4 {
     }
 }
 
-/// Runs PX4 (since 2022) for `runs` cycles; the device latches sample k 1 µs after the chip's
-/// k-th sequence starts. Returns the driver and the fields latched.
+/// Runs PX4 (since 2022) for `runs` cycles, the device latching the [`samples`] as [`Bench`]
+/// does. Returns the driver and the fields.
 fn run_current(link: Link, strict: bool, runs: u64) -> (Px4, Vec<[f32; 3]>) {
     let mut mag = Rm3100::new();
     mag.set_strict_cmm(strict);
@@ -110,8 +110,7 @@ fn run_current(link: Link, strict: bool, runs: u64) -> (Px4, Vec<[f32; 3]>) {
     // TMRC 0x95 (13.3 ms) is slower than the 6.85 ms measurement.
     let period = continuous_period_ns(0x95, 0b111, [200; 3]);
     assert_eq!(period, 13_333_333);
-    let fields = samples(2 + (runs * RUN_NS / period) as usize);
-    let mut latched = 0;
+    let mut bench = Bench::new(t_cfg, period, t_cfg + runs * RUN_NS);
     let mut px4 = Px4 {
         prev: [0; 3],
         failures: 0,
@@ -119,18 +118,10 @@ fn run_current(link: Link, strict: bool, runs: u64) -> (Px4, Vec<[f32; 3]>) {
         published: Vec::new(),
     };
     for j in 1..=runs {
-        let now = t_cfg + j * RUN_NS;
-        while t_cfg + latched as u64 * period + US <= now {
-            mag.latch_at(
-                &field(fields[latched]),
-                t_cfg + latched as u64 * period + US,
-            );
-            latched += 1;
-        }
-        mag.advance(now);
+        bench.run_to(&mut mag, t_cfg + j * RUN_NS);
         px4.run(&mut mag, link);
     }
-    (px4, fields)
+    (px4, bench.fields)
 }
 
 #[test]

@@ -104,6 +104,42 @@ pub fn assert_sample(
     );
 }
 
+/// The device side of a continuous-mode run: latches `fields[k]` 1 µs after the chip's k-th
+/// measurement sequence starts, at `start + k · period` (the z axis of the sequence before
+/// completes at the start), and moves the chip's clock.
+pub struct Bench {
+    pub start: u64,
+    pub period: u64,
+    pub fields: Vec<[f32; 3]>,
+    latched: usize,
+}
+
+impl Bench {
+    /// Enough [`samples`] for a run until `end`.
+    pub fn new(start: u64, period: u64, end: u64) -> Self {
+        let fields = samples(2 + ((end - start) / period) as usize);
+        Self {
+            start,
+            period,
+            fields,
+            latched: 0,
+        }
+    }
+
+    /// Latches the samples due by `now`, then advances the chip to `now`.
+    pub fn run_to(&mut self, mag: &mut Rm3100, now: u64) {
+        loop {
+            let at = self.start + self.latched as u64 * self.period + US;
+            if at > now {
+                break;
+            }
+            mag.latch_at(&field(self.fields[self.latched]), at);
+            self.latched += 1;
+        }
+        mag.advance(now);
+    }
+}
+
 /// A field sequence (µT, chip axes) sweeping every axis through both signs, inside ±800 µT.
 pub fn samples(n: usize) -> Vec<[f32; 3]> {
     (0..n)
