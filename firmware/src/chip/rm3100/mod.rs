@@ -41,8 +41,9 @@
 //! a BIST write clears them. The results are not changed.
 //!
 //! **Not the DS literally.** The DS notes that reading CMM or writing TMRC ends continuous mode.
-//! ArduPilot re-reads CMM once a second (its register check) and PX4 writes TMRC after CMM, and
-//! both read data from the real part; so by default neither stops it.
+//! ArduPilot re-reads CMM once a second (its register check) and PX4 writes TMRC after CMM; under
+//! the note ArduPilot would lose most of its data and PX4 all of it, yet both are in use with the
+//! real part on many boards, so by default neither stops it.
 //! [`Rm3100::set_strict_cmm`] applies the note.
 //!
 //! **Buses.** I2C at the address set by SA0/SA1 (0x20–0x23), a register pointer written first,
