@@ -21,6 +21,13 @@
 //!     stream mode with 20-bit packets: FIFO_CONFIG1 HIRES + TEMP + GYRO + ACCEL), refilled
 //!     between timed reads.
 //!
+//! The RM3100 on its own ([`Rm3100`], not yet an `EmulatedChip`), in continuous mode on x, y, z
+//! at 200 cycle counts (ArduPilot's and PX4's setup):
+//! (7) `rm3100/latch_at`: one physical sample per measurement sequence (3 axes converted, the
+//!     results published);
+//! (8) `rm3100/spi burst` and `rm3100/i2c burst`: the 9 result bytes from 0x24 (SPI: select,
+//!     0x80 | 0x24 + 9 bytes, deselect; I2C: register pointer, repeated START, 9 reads, STOP).
+//!
 //! The requirement: well under one byte time of a 20 MHz SPI clock (400 ns) per byte.
 //!
 //! `cargo bench -p margemu-firmware --bench chip -- --warm-up-time 1 --measurement-time 3`
@@ -29,7 +36,9 @@
 #![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use margemu_firmware::chip::{Chip, EmulatedChip, I2cTarget, Mpu6xxx, PhysicalSample, SpiTarget};
+use margemu_firmware::chip::{
+    Chip, EmulatedChip, I2cTarget, Mpu6xxx, PhysicalSample, Rm3100, SpiTarget,
+};
 use margemu_protocol::chip::{ChipModel, ChipSettings, Family};
 use margemu_protocol::regmap::mpu6xxx::image::{ImageConfig, ImageRepr};
 use std::hint::black_box;
@@ -316,5 +325,63 @@ fn per_chip(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, latch, burst, per_chip);
+/// An RM3100 measuring x, y, z continuously at 200 cycle counts (CMM = 0x71, TMRC = 0x94): one
+/// sequence every 6.85 ms.
+fn rm3100_continuous() -> (Rm3100, u64) {
+    let mut mag = Rm3100::new();
+    for (reg, value) in [(0x0B, 0x94), (0x01, 0x71)] {
+        mag.start(0x20, false);
+        mag.write(reg);
+        mag.write(value);
+        mag.stop();
+    }
+    let period = margemu_protocol::regmap::rm3100::continuous_period_ns(0x94, 0b111, [200; 3]);
+    (mag, period)
+}
+
+fn rm3100(c: &mut Criterion) {
+    let s = sample();
+    let mut group = c.benchmark_group("rm3100");
+    let (mut mag, period) = rm3100_continuous();
+    let mut now = 0u64;
+    group.bench_function("latch_at", |b| {
+        b.iter(|| {
+            now += period;
+            mag.latch_at(black_box(&s), now);
+        })
+    });
+
+    let (mut mag, period) = rm3100_continuous();
+    mag.latch_at(&s, 0);
+    mag.advance(period);
+    let mut mosi = [0u8; 10];
+    mosi[0] = 0x80 | 0x24;
+    group.throughput(Throughput::Bytes(mosi.len() as u64));
+    group.bench_function("spi burst 0xA4 + 9 bytes", |b| {
+        b.iter(|| {
+            let mut acc = mag.select();
+            for &byte in black_box(&mosi) {
+                acc ^= mag.exchange(byte);
+            }
+            mag.deselect();
+            acc
+        })
+    });
+    group.bench_function("i2c burst 0x24 + 9 bytes", |b| {
+        b.iter(|| {
+            mag.start(0x20, false);
+            mag.write(black_box(0x24));
+            mag.start(0x20, true);
+            let mut acc = 0u8;
+            for _ in 0..9 {
+                acc ^= mag.read();
+            }
+            mag.stop();
+            acc
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, latch, burst, per_chip, rm3100);
 criterion_main!(benches);

@@ -31,6 +31,8 @@
 //! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer (I2C only);
 //! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer (I2C only); both share their
 //!   [`Chip`] boundary ([`magnetometer`]) and I2C front end ([`pointer_i2c`]).
+//! - [`Rm3100`]: the PNI RM3100 magnetometer, as an [`I2cTarget`] and an [`SpiTarget`] (not yet
+//!   an [`EmulatedChip`]).
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
@@ -43,6 +45,7 @@ pub mod magnetometer;
 pub mod mpu6xxx;
 pub mod pointer_i2c;
 pub mod qmc5883l;
+pub mod rm3100;
 mod spi_phase;
 mod write_log;
 
@@ -52,6 +55,7 @@ pub use icm42688p::Icm42688p;
 pub use ist8310::Ist8310;
 pub use mpu6xxx::{Config, Mpu6xxx, Variant};
 pub use qmc5883l::Qmc5883l;
+pub use rm3100::Rm3100;
 pub use write_log::{Bus, RegisterWrite, WriteLog};
 
 /// The SPI target side of a chip (mode 0/3, MSB first), byte by byte.

@@ -14,7 +14,8 @@
 //!   sensor time);
 //! - [`ist8310`]: the iSentek IST8310 standalone I2C magnetometer;
 //! - [`qmc5883l`]: the QST QMC5883L standalone I2C magnetometer;
-//! - [`mag_image`]: the 6-byte register image both standalone magnetometers share.
+//! - [`rm3100`]: the PNI RM3100 magneto-inductive magnetometer (I2C or SPI, 24-bit results);
+//! - [`mag_image`]: the 6-byte register image the IST8310 and QMC5883L share.
 //!
 //! Both the firmware (which serves these values) and the host (which predicts what a driver
 //! reads) call the same functions, so they agree bit for bit.
@@ -32,5 +33,6 @@ pub mod ist8310;
 pub mod mag_image;
 pub mod mpu6xxx;
 pub mod qmc5883l;
+pub mod rm3100;
 
 pub use mpu6xxx::image::IMAGE_LEN;
