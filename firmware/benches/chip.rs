@@ -21,7 +21,7 @@
 //!     stream mode with 20-bit packets: FIFO_CONFIG1 HIRES + TEMP + GYRO + ACCEL), refilled
 //!     between timed reads.
 //!
-//! The RM3100 on its own ([`Rm3100`], not yet an `EmulatedChip`), in continuous mode on x, y, z
+//! The RM3100 on its own ([`Rm3100`]), in continuous mode on x, y, z
 //! at 200 cycle counts (ArduPilot's and PX4's setup):
 //! (7) `rm3100/latch_at`: one physical sample per measurement sequence (3 axes converted, the
 //!     results published);
@@ -162,6 +162,8 @@ fn powered(model: ChipModel) -> EmulatedChip {
         Family::Icm42688p => spi_write(&mut chip, &[0x4E, 0x0F]),
         Family::Qmc5883l => assert!(chip.write_register(0, 0x09, 0x0D)),
         Family::Ist8310 => {}
+        // Continuous measurement of x, y, z at TMRC's reset rate.
+        Family::Rm3100 => assert!(chip.write_register(0, 0x01, 0x71)),
     }
     chip
 }

@@ -180,10 +180,34 @@ pub fn stream_scene(rate_hz: f64, seconds: f64) -> Scene {
     Scene::parse_str(&text, std::path::Path::new("bench-stream.toml")).expect("a valid scene")
 }
 
-/// Streams [`stream_scene`] with `chip` (at power-on; any rate, to find the link's limits)
-/// at each rate and source through the loopback device, writing each session's logs under `dir`.
+/// The devices of [`rig_stream_scene`]: the usual sensor set of a flight controller with two
+/// IMUs, an ICM-42688-P and an MPU-6000 on SPI and an IST8310 compass on I2C.
+pub const RIG_DEVICES: &str = "[[device]]\nname = \"imu0\"\nmodel = \"icm42688p\"\n\
+    [[device]]\nname = \"imu1\"\nmodel = \"mpu6000\"\nchip_select = 1\n\
+    [[device]]\nname = \"compass\"\nmodel = \"ist8310\"\n";
+
+/// [`stream_scene`] served by the three-device rig [`RIG_DEVICES`] (`rate_hz` must be an output
+/// rate of both IMUs: 1, 2, 4 or 8 kHz, say).
+pub fn rig_stream_scene(rate_hz: f64, seconds: f64) -> Result<Scene, String> {
+    let text = stream_scene(rate_hz, seconds).text + RIG_DEVICES;
+    Scene::parse_str(&text, std::path::Path::new("bench-stream-rig.toml"))
+        .map_err(|e| e.to_string())
+}
+
+/// What [`stream_sweep`] streams: one chip at power-on (any rate, to find the link's limits),
+/// or the three-device rig of [`rig_stream_scene`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Streamed {
+    /// One chip.
+    Chip(margemu_protocol::chip::ChipModel),
+    /// [`RIG_DEVICES`].
+    Rig,
+}
+
+/// Streams [`stream_scene`] (with `what`) at each rate and source through the loopback device,
+/// writing each session's logs under `dir`.
 pub fn stream_sweep(
-    chip: margemu_protocol::chip::ChipModel,
+    what: Streamed,
     rates: &[f64],
     sources: &[SourceMode],
     seconds: f64,
@@ -192,8 +216,16 @@ pub fn stream_sweep(
     let mut rows = Vec::new();
     for &source in sources {
         for &rate_hz in rates {
-            let mut scene = stream_scene(rate_hz, seconds);
-            scene.chip = margemu_sim::scene::chip::ChipSetup::power_on(chip);
+            let scene = match what {
+                Streamed::Chip(chip) => {
+                    let mut scene = stream_scene(rate_hz, seconds);
+                    scene.chip = margemu_sim::scene::chip::ChipSetup::power_on(chip);
+                    scene.chip_name = chip.name().to_owned();
+                    scene
+                }
+                Streamed::Rig => rig_stream_scene(rate_hz, seconds)
+                    .map_err(|reason| margemu_hil::stream::StreamError::Model { reason })?,
+            };
             let mode = match source {
                 SourceMode::Images => "images",
                 SourceMode::Model { .. } => "model",
@@ -231,8 +263,11 @@ pub fn stream_sweep(
 /// One row of the link table: a batch of `items` items of `item_len` bytes.
 #[derive(Clone, Copy, Debug)]
 pub struct LinkRow {
-    /// What the items are: a chip model's images, or kinematics (`None`).
+    /// What the items are: a chip model's images, or (`None`) the rig's images ([`Self::rig`])
+    /// or kinematics.
     pub chip: Option<margemu_protocol::chip::ChipModel>,
+    /// Whether the items are the images of the rig of [`RIG_DEVICES`].
+    pub rig: bool,
     /// Items per batch frame.
     pub items: usize,
     /// Bytes per item (the model's image length, 53 for kinematics).
@@ -261,11 +296,19 @@ pub fn link_table() -> Vec<LinkRow> {
         max_images_per_batch, IMAGE_BATCH_HEADER_LEN, MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
     };
     let mut rows = Vec::new();
-    for chip in ChipModel::ALL {
-        let len = chip.image_len();
+    let rig_len = [ChipModel::Icm42688p, ChipModel::Mpu6000, ChipModel::Ist8310]
+        .map(ChipModel::image_len)
+        .iter()
+        .sum();
+    let images = ChipModel::ALL
+        .map(|chip| (Some(chip), chip.image_len()))
+        .into_iter()
+        .chain([(None, rig_len)]);
+    for (chip, len) in images {
         for items in [1, 8, 16, 32, max_images_per_batch(len)] {
             rows.push(LinkRow {
-                chip: Some(chip),
+                chip,
+                rig: chip.is_none(),
                 items,
                 item_len: len,
                 wire_bytes: margemu_hil::stream::batch_wire_len(items, len, IMAGE_BATCH_HEADER_LEN),
@@ -275,6 +318,7 @@ pub fn link_table() -> Vec<LinkRow> {
     for items in [1, 8, 16, MAX_KINEMATICS_PER_BATCH] {
         rows.push(LinkRow {
             chip: None,
+            rig: false,
             items,
             item_len: TRUTH_LEN,
             wire_bytes: margemu_hil::stream::batch_wire_len(items, TRUTH_LEN, 8),

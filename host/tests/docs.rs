@@ -280,7 +280,7 @@ fn every_page_of_the_guide_is_in_the_summary() {
 
 /// Tables a scene has at its top level: a TOML block whose first header is one of these is a
 /// scene fragment.
-const SCENE_TABLES: [&str; 8] = [
+const SCENE_TABLES: [&str; 9] = [
     "integrator",
     "field",
     "bench",
@@ -289,6 +289,7 @@ const SCENE_TABLES: [&str; 8] = [
     "sensors",
     "perturbation",
     "chip",
+    "device",
 ];
 
 /// A TOML block as scene text, or `None` when it is not a scene example (see the module docs).
@@ -303,7 +304,7 @@ fn scene_example(block: &str) -> Option<String> {
     }) {
         return Some(block.to_string());
     }
-    let header = lines.next()?.strip_prefix('[')?;
+    let header = lines.next()?.strip_prefix('[')?.trim_start_matches('[');
     let table = header.split(['.', ']']).next()?.trim();
     SCENE_TABLES
         .contains(&table)

@@ -53,7 +53,7 @@ fn chips_are_a_set_of_model_codes() {
     let all = ChipModel::ALL
         .into_iter()
         .fold(Chips::EMPTY, |c, m| c | Chips::of(m));
-    assert_eq!(all, Chips(0xDF)); // code 5 is not taken yet
+    assert_eq!(all, Chips(0x1DF)); // code 5 is not taken yet
     assert!(all.models().eq(ChipModel::ALL));
     // Unknown bits (a newer device's models) are kept on the wire and skipped by `models`.
     let newer = Chips(0x8000_0000 | Chips::of(ChipModel::Icm42688p).0);
@@ -73,7 +73,7 @@ fn chips_are_a_set_of_model_codes() {
         },
     });
     let b = payload(&m);
-    assert_eq!((b[0], b[1]), (3, 0));
+    assert_eq!((b[0], b[1]), (4, 0));
     assert_eq!(b[25..29], [0x10, 0, 0, 0x80]);
     parses_back(Kind::HelloAck, &b, &m);
 }
@@ -192,7 +192,7 @@ fn register_writes_and_error() {
     assert_eq!(b, [8, 0x02, 0x01, 0x0D, 0x0C, 0x0B, 0x0A]);
     parses_back(Kind::Error, &b, &m);
     assert_eq!(
-        Message::parse(0x86, &[10, 0, 0, 0, 0, 0, 0]),
+        Message::parse(0x86, &[11, 0, 0, 0, 0, 0, 0]),
         Err(Error::InvalidValue)
     );
 }
@@ -326,7 +326,16 @@ fn configure_names_the_chip() {
     }
     assert_eq!(
         ChipModel::ALL.map(|m| (m.code(), m.image_len())),
-        [(0, 22), (1, 14), (2, 14), (3, 14), (4, 32), (6, 6), (7, 6)]
+        [
+            (0, 22),
+            (1, 14),
+            (2, 14),
+            (3, 14),
+            (4, 32),
+            (6, 6),
+            (7, 6),
+            (8, 9)
+        ]
     );
     // Identity, image length and address are carried as they are (the device judges them);
     // an override's file is a plain byte numbered by the model.
@@ -398,11 +407,14 @@ fn image_batch_refusals() {
     assert_eq!(parse(0, &[]), Ok(9));
     assert_eq!(parse(32, &[0x20; 64]), Ok(73));
     assert_eq!(parse(1, &[0x01; 3]), Ok(12));
-    // Length 0 with images, above 32, or not dividing the images' bytes.
+    // A rig's image: up to 128 bytes.
+    assert_eq!(parse(38, &[0x5A; 76]), Ok(85));
+    assert_eq!(parse(128, &[0; 128]), Ok(137));
+    // Length 0 with images, above 128, or not dividing the images' bytes.
     assert_eq!(parse(0, &[1]), Err(Error::InvalidValue));
     assert_eq!(parse(0, &[0; 22]), Err(Error::InvalidValue));
-    assert_eq!(parse(33, &[0; 33]), Err(Error::InvalidValue));
-    assert_eq!(parse(33, &[]), Err(Error::InvalidValue));
+    assert_eq!(parse(129, &[0; 129]), Err(Error::InvalidValue));
+    assert_eq!(parse(129, &[]), Err(Error::InvalidValue));
     assert_eq!(parse(0xFF, &[0; 255]), Err(Error::InvalidValue));
     assert_eq!(parse(22, &[0; 23]), Err(Error::PayloadTooLong));
     assert_eq!(parse(22, &[0; 14]), Err(Error::PayloadTooLong));
@@ -457,4 +469,34 @@ fn images_per_batch_by_length() {
     for model in ChipModel::ALL {
         assert!(max_images_per_batch(model.image_len()) >= 47);
     }
+}
+
+#[test]
+fn add_device_carries_the_rig_device_and_refuses_what_it_cannot() {
+    use margemu_protocol::link::{AddDevice, DeviceBus, RegisterOverride};
+    let mut add = AddDevice::new(ChipModel::Rm3100, DeviceBus::Spi);
+    add.chip_select = 2;
+    add.overrides
+        .push(RegisterOverride {
+            file: 0,
+            register: 0x0B,
+            value: 0x94,
+        })
+        .unwrap();
+    let m = Message::AddDevice(add);
+    let b = payload(&m);
+    assert_eq!(b, [8, 0x22, 9, 0, 0x20, 2, 1, 0, 0x0B, 0x94]);
+    parses_back(Kind::AddDevice, &b, &m);
+    // A bus byte other than 0 or 1, an unknown chip code, more overrides than 8, a short payload.
+    assert_eq!(
+        Message::parse(0x05, &[8, 0x22, 9, 2, 0x20, 0, 0]),
+        Err(Error::InvalidValue)
+    );
+    assert_eq!(
+        Message::parse(0x05, &[9, 0x24, 14, 0, 0x68, 0, 0]),
+        Err(Error::UnknownChip)
+    );
+    let nine = [&[8u8, 0x22, 9, 1, 0x20, 0, 9][..], &[0u8; 27]].concat();
+    assert_eq!(Message::parse(0x05, &nine), Err(Error::InvalidValue));
+    assert!(Message::parse(0x05, &[8, 0x22, 9, 1]).is_err());
 }

@@ -21,7 +21,7 @@ use margemu_protocol::chip::{ChipModel, ChipSettings, PhysicalSample};
 
 use super::icm42688p::{self, Icm42688p};
 use super::mpu6xxx::{self, Mpu6xxx, Variant};
-use super::{I2cTarget, Ist8310, Qmc5883l, RegisterWrite, SpiTarget};
+use super::{I2cTarget, Ist8310, Qmc5883l, RegisterWrite, Rm3100, SpiTarget};
 
 /// What every emulated chip does for the link, the boards and the host (see the module docs).
 /// Time is the scene time in ns, moved forward only by latches and [`Chip::advance`].
@@ -116,6 +116,8 @@ pub enum EmulatedChip {
     Ist8310(Ist8310),
     /// The QST QMC5883L magnetometer.
     Qmc5883l(Qmc5883l),
+    /// The PNI RM3100 magnetometer.
+    Rm3100(Rm3100),
 }
 
 impl Default for EmulatedChip {
@@ -145,6 +147,13 @@ impl EmulatedChip {
             ChipModel::Qmc5883l => {
                 return Some(Self::Qmc5883l(Qmc5883l::with_address(i2c_address)))
             }
+            ChipModel::Rm3100 => {
+                let pins = i2c_address.wrapping_sub(0x20);
+                return Some(Self::Rm3100(Rm3100::with_pins(
+                    pins & 1 != 0,
+                    pins & 2 != 0,
+                )));
+            }
             _ => {}
         }
         let variant = Variant::for_model(model, who_am_i)?;
@@ -160,7 +169,7 @@ impl EmulatedChip {
         ChipModel::ALL.into_iter().filter(|m| {
             matches!(
                 m,
-                ChipModel::Icm42688p | ChipModel::Ist8310 | ChipModel::Qmc5883l
+                ChipModel::Icm42688p | ChipModel::Ist8310 | ChipModel::Qmc5883l | ChipModel::Rm3100
             ) || Variant::for_model(*m, m.who_am_i()).is_some()
         })
     }
@@ -174,6 +183,7 @@ macro_rules! each_chip {
             EmulatedChip::Icm42688p($chip) => $call,
             EmulatedChip::Ist8310($chip) => $call,
             EmulatedChip::Qmc5883l($chip) => $call,
+            EmulatedChip::Rm3100($chip) => $call,
         }
     };
 }

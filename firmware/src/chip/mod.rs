@@ -31,8 +31,7 @@
 //! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer (I2C only);
 //! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer (I2C only); both share their
 //!   [`Chip`] boundary ([`magnetometer`]) and I2C front end ([`pointer_i2c`]).
-//! - [`Rm3100`]: the PNI RM3100 magnetometer, as an [`I2cTarget`] and an [`SpiTarget`] (not yet
-//!   an [`EmulatedChip`]).
+//! - [`Rm3100`]: the PNI RM3100 magnetometer, on I2C and SPI.
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 

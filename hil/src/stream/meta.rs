@@ -64,7 +64,10 @@ pub(super) fn metadata(
                 accel_offset: i.accel_offset,
             }),
             // The others' conversions are their ranges, already in `[chip]`.
-            Conversion::Icm42688p(_) | Conversion::Ist8310 | Conversion::Qmc5883l(_) => None,
+            Conversion::Icm42688p(_)
+            | Conversion::Ist8310
+            | Conversion::Qmc5883l(_)
+            | Conversion::Rm3100(_) => None,
         },
         scene_text: scene.text.clone(),
         device: None,

@@ -1,7 +1,7 @@
 //! `margemu bench stream`: streaming speed against error, measured here and now.
 
 use anyhow::Result;
-use margemu::perf::{link_table, stream_sweep, StreamRow};
+use margemu::perf::{link_table, stream_sweep, StreamRow, Streamed};
 use margemu::stream::{JitterStats, SourceMode};
 use margemu_protocol::chip::ChipModel;
 use std::path::PathBuf;
@@ -27,6 +27,10 @@ pub struct Cmd {
     /// The chip model the device emulates (power-on settings; `margemu chips` lists them).
     #[arg(long, default_value = "mpu9250")]
     chip: String,
+    /// Stream a rig instead of one chip: an ICM-42688-P and an MPU-6000 on SPI and an IST8310
+    /// on I2C, 52-byte images (register images only; rates both IMUs have, up to 8 kHz).
+    #[arg(long, conflicts_with = "chip")]
+    rig: bool,
 }
 
 impl Cmd {
@@ -42,22 +46,41 @@ impl Cmd {
                 margemu::scene::chip::model_names()
             )
         })?;
-        let sources = [
-            SourceMode::Images,
-            SourceMode::Model {
-                kinematics_hz: None,
-            },
-        ];
+        let model = SourceMode::Model {
+            kinematics_hz: None,
+        };
+        let (what, sources, served) = if self.rig {
+            let len = margemu::perf::rig_stream_scene(1000.0, 1.0)
+                .map_err(anyhow::Error::msg)?
+                .devices()
+                .iter()
+                .map(|d| d.chip.model.image_len())
+                .sum::<usize>();
+            let served = format!(
+                "a rig of an emulated ICM-42688-P and MPU-6000 on SPI and an IST8310 compass on \
+                 I2C (measuring on its own schedule), {len} B images"
+            );
+            (Streamed::Rig, vec![SourceMode::Images], served)
+        } else {
+            let served = format!(
+                "an emulated {}, {} B images",
+                chip.part_name(),
+                chip.image_len()
+            );
+            (
+                Streamed::Chip(chip),
+                vec![SourceMode::Images, model],
+                served,
+            )
+        };
         println!(
-            "Each row streams a {} s kinematic scene (noise on every sensor, an emulated {}, {} B \
-             images) in real time through a PTY pair to the firmware's link handler (loopback device, buffer {} samples), and checks \
-             the CRC-32C of every image it served against the host's prediction. Lost = scene \
-             samples not served byte for byte (underruns, mismatches, unreported). Pacing: how \
-             late each batch's write started against the scene clock; written: how late it \
-             completed (the PTY write included).\n",
+            "Each row streams a {} s kinematic scene (noise on every sensor, {served}) in real \
+             time through a PTY pair to the firmware's link handler (loopback device, buffer {} \
+             samples), and checks the CRC-32C of every image it served against the host's \
+             prediction. Lost = scene samples not served byte for byte (underruns, mismatches, \
+             unreported). Pacing: how late each batch's write started against the scene clock; \
+             written: how late it completed (the PTY write included).\n",
             self.seconds,
-            chip.part_name(),
-            chip.image_len(),
             margemu::loopback::BUFFER,
         );
         println!(
@@ -69,7 +92,7 @@ impl Cmd {
         });
         for &source in &sources {
             for &rate in &self.rates {
-                let row = stream_sweep(chip, &[rate], &[source], self.seconds, &dir)?;
+                let row = stream_sweep(what, &[rate], &[source], self.seconds, &dir)?;
                 if self.keep.is_none() {
                     std::fs::remove_dir_all(&dir)?;
                 }
@@ -87,6 +110,10 @@ impl Cmd {
         for l in link_table() {
             let kind = match l.chip {
                 Some(chip) => format!("{} images ({} B)", chip.part_name(), l.item_len),
+                None if l.rig => format!(
+                    "rig images ({} B: ICM-42688-P + MPU-6000 + IST8310)",
+                    l.item_len
+                ),
                 None => "kinematics".to_owned(),
             };
             let rates = BAUDS.map(|b| format!("{:.0} /s", l.items_per_s(b)));

@@ -15,6 +15,8 @@ pub enum Family {
     Ist8310,
     /// QST QMC5883L magnetometer ([`crate::regmap::qmc5883l`]).
     Qmc5883l,
+    /// PNI RM3100 magnetometer ([`crate::regmap::rm3100`]).
+    Rm3100,
 }
 
 /// An emulated chip model. Its wire code ([`ChipModel::code`]) is the bit of
@@ -37,11 +39,13 @@ pub enum ChipModel {
     Ist8310 = 6,
     /// QST QMC5883L magnetometer (I2C only), chip id 0xFF.
     Qmc5883l = 7,
+    /// PNI RM3100 magnetometer (SPI and I2C), REVID 0x22.
+    Rm3100 = 8,
 }
 
 impl ChipModel {
     /// Every model, in code order.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 8] = [
         Self::Mpu9250,
         Self::Mpu6500,
         Self::Mpu6000,
@@ -49,6 +53,7 @@ impl ChipModel {
         Self::Icm42688p,
         Self::Ist8310,
         Self::Qmc5883l,
+        Self::Rm3100,
     ];
 
     /// The model's code on the link.
@@ -71,6 +76,7 @@ impl ChipModel {
             Self::Icm42688p => "icm42688p",
             Self::Ist8310 => "ist8310",
             Self::Qmc5883l => "qmc5883l",
+            Self::Rm3100 => "rm3100",
         }
     }
 
@@ -84,6 +90,7 @@ impl ChipModel {
             Self::Icm42688p => "ICM-42688-P",
             Self::Ist8310 => "IST8310",
             Self::Qmc5883l => "QMC5883L",
+            Self::Rm3100 => "RM3100",
         }
     }
 
@@ -105,6 +112,7 @@ impl ChipModel {
             Self::Icm42688p => Family::Icm42688p,
             Self::Ist8310 => Family::Ist8310,
             Self::Qmc5883l => Family::Qmc5883l,
+            Self::Rm3100 => Family::Rm3100,
             _ => Family::Mpu6xxx,
         }
     }
@@ -112,12 +120,12 @@ impl ChipModel {
     /// What the part measures: an IMU (accelerometer and gyroscope, perhaps a magnetometer too)
     /// or a magnetometer alone.
     pub const fn is_magnetometer_only(self) -> bool {
-        matches!(self, Self::Ist8310 | Self::Qmc5883l)
+        matches!(self, Self::Ist8310 | Self::Qmc5883l | Self::Rm3100)
     }
 
     /// The WHO_AM_I value of the part itself (the first of [`ChipModel::identities`]; for the
     /// magnetometers, the identity register drivers check: the IST8310's WAI, the
-    /// QMC5883L's chip id register 0x0D).
+    /// QMC5883L's chip id register 0x0D, the RM3100's REVID).
     pub const fn who_am_i(self) -> u8 {
         self.identities()[0]
     }
@@ -133,12 +141,13 @@ impl ChipModel {
             Self::Icm42688p => &[0x47],
             Self::Ist8310 => &[crate::regmap::ist8310::WAI_VALUE],
             Self::Qmc5883l => &[crate::regmap::qmc5883l::CHIP_ID_VALUE],
+            Self::Rm3100 => &[crate::regmap::rm3100::REVID_VALUE],
         }
     }
 
-    /// The buses the part has: SPI and I2C, except the magnetometers (I2C only).
+    /// The buses the part has: SPI and I2C, except the IST8310 and QMC5883L (I2C only).
     pub const fn buses(self) -> Buses {
-        if self.is_magnetometer_only() {
+        if matches!(self, Self::Ist8310 | Self::Qmc5883l) {
             Buses::I2C
         } else {
             Buses(Buses::SPI.0 | Buses::I2C.0)
@@ -146,11 +155,13 @@ impl ChipModel {
     }
 
     /// The 7-bit I2C addresses the part can be strapped to (the default first: AD0 low for the
-    /// IMUs; the IST8310's CAD pins give 0x0C–0x0F, 0x0E with both low; the QMC5883L has one).
+    /// IMUs; the IST8310's CAD pins give 0x0C–0x0F, 0x0E with both low; the QMC5883L has one;
+    /// the RM3100's SA0/SA1 pins give 0x20–0x23).
     pub const fn i2c_addresses(self) -> &'static [u8] {
         match self {
             Self::Ist8310 => &crate::regmap::ist8310::I2C_ADDRESSES,
             Self::Qmc5883l => &[crate::regmap::qmc5883l::I2C_ADDRESS],
+            Self::Rm3100 => &[0x20, 0x21, 0x22, 0x23],
             _ => &[0x68, 0x69],
         }
     }
@@ -168,7 +179,10 @@ impl ChipModel {
 
     /// Whether the package holds a magnetometer.
     pub const fn has_magnetometer(self) -> bool {
-        matches!(self, Self::Mpu9250 | Self::Ist8310 | Self::Qmc5883l)
+        matches!(
+            self,
+            Self::Mpu9250 | Self::Ist8310 | Self::Qmc5883l | Self::Rm3100
+        )
     }
 
     /// What the emulation covers, for `margemu chips` (one line per item; the chip module's
@@ -202,6 +216,12 @@ impl ChipModel {
                 "continuous mode at 10/50/100/200 Hz, ranges 2 G and 8 G",
                 "STATUS DRDY, OVL and DOR (data skipped), soft reset, pointer roll-over",
             ],
+            Family::Rm3100 => &[
+                "SPI (STATUS during the address byte) and I2C at 0x20-0x23, read-back, HSHAKE",
+                "single (POLL) and continuous (CMM, TMRC) measurements, axis by axis in time",
+                "cycle counts setting gain and measurement time, 24-bit results, STATUS DRDY",
+                "the built-in self test (BIST)",
+            ],
         }
     }
 
@@ -220,6 +240,7 @@ impl ChipModel {
                 &["temperature output, self-test field, 16-bit output mode, the DRDY pin"]
             }
             Family::Qmc5883l => &["temperature output, over-sampling noise, the DRDY pin"],
+            Family::Rm3100 => &["the DRDY pin, noise, the output's bend beyond +-800 uT"],
         }
     }
 
@@ -233,6 +254,7 @@ impl ChipModel {
             Self::Icm42688p => crate::regmap::icm42688p::image::IMAGE_LEN,
             Self::Ist8310 => crate::regmap::ist8310::IMAGE_LEN,
             Self::Qmc5883l => crate::regmap::qmc5883l::IMAGE_LEN,
+            Self::Rm3100 => crate::regmap::rm3100::IMAGE_LEN,
         }
     }
 
@@ -251,7 +273,7 @@ impl ChipModel {
             }
             Self::Icm42688p => crate::regmap::icm42688p::Odr::gyro_of_hz(rate_hz).is_some(),
             // A magnetometer measures on its own schedule; any rate of the rig's IMU serves it.
-            Self::Ist8310 | Self::Qmc5883l => rate_hz > 0.0,
+            Self::Ist8310 | Self::Qmc5883l | Self::Rm3100 => rate_hz > 0.0,
         }
     }
 }

@@ -6,7 +6,7 @@ use crate::regmap::icm42688p::image::{ImageConfig as IcmConfig, ImageRepr as Icm
 use crate::regmap::icm42688p::{self as icm, convert as icm_convert};
 use crate::regmap::mpu6xxx::image::{ImageConfig as Mpu6xxxConfig, ImageRepr as Mpu6xxxRepr};
 use crate::regmap::mpu6xxx::{self as mpu, AccelFs, GyroFs};
-use crate::regmap::{ist8310, mag_image, qmc5883l};
+use crate::regmap::{ist8310, mag_image, qmc5883l, rm3100};
 
 /// The conversion settings of one chip family (full scales, offsets, magnetometer settings).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -19,6 +19,8 @@ pub enum Conversion {
     Ist8310,
     /// QMC5883L at a range.
     Qmc5883l(qmc5883l::Range),
+    /// RM3100 at cycle counts x, y, z (its gain).
+    Rm3100([u16; 3]),
 }
 
 /// A full-scale choice: accelerometer range in g, gyroscope range in °/s.
@@ -82,6 +84,7 @@ impl ChipSettings {
             Family::Icm42688p => Conversion::Icm42688p(IcmConfig::NOMINAL),
             Family::Ist8310 => Conversion::Ist8310,
             Family::Qmc5883l => Conversion::Qmc5883l(qmc5883l::Range::default()),
+            Family::Rm3100 => Conversion::Rm3100([rm3100::reset::CYCLE_COUNT; 3]),
         };
         Self { model, conversion }
     }
@@ -131,7 +134,7 @@ impl ChipSettings {
                     .find(|g| g.range_dps() == fs.gyro_dps)
                     .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
             }
-            Conversion::Ist8310 | Conversion::Qmc5883l(_) => {
+            Conversion::Ist8310 | Conversion::Qmc5883l(_) | Conversion::Rm3100(_) => {
                 return Err(SettingsError::AccelRange(fs.accel_g))
             }
         }
@@ -146,7 +149,7 @@ impl ChipSettings {
                 .map(|a| f64::from(a.range_g()))
                 .collect(),
             Family::Icm42688p => icm::AccelFs::ALL.iter().map(|a| a.range_g()).collect(),
-            Family::Ist8310 | Family::Qmc5883l => heapless::Vec::new(),
+            Family::Ist8310 | Family::Qmc5883l | Family::Rm3100 => heapless::Vec::new(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -160,7 +163,7 @@ impl ChipSettings {
                 .map(|g| f64::from(g.range_dps()))
                 .collect(),
             Family::Icm42688p => icm::GyroFs::ALL.iter().map(|g| g.range_dps()).collect(),
-            Family::Ist8310 | Family::Qmc5883l => heapless::Vec::new(),
+            Family::Ist8310 | Family::Qmc5883l | Family::Rm3100 => heapless::Vec::new(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -177,7 +180,7 @@ impl ChipSettings {
                 accel_g: cfg.accel_fs.range_g(),
                 gyro_dps: cfg.gyro_fs.range_dps(),
             }),
-            Conversion::Ist8310 | Conversion::Qmc5883l(_) => None,
+            Conversion::Ist8310 | Conversion::Qmc5883l(_) | Conversion::Rm3100(_) => None,
         }
     }
 
@@ -202,7 +205,9 @@ impl ChipSettings {
                 (0, mpu::reg::GYRO_CONFIG, cfg.gyro_fs.bits() << 3),
                 (0, mpu::reg::ACCEL_CONFIG, cfg.accel_fs.bits() << 3),
             ]),
-            Conversion::Ist8310 => heapless::Vec::new(),
+            // The RM3100's cycle counts are its driver's to set (200, their reset value, in
+            // ArduPilot and PX4).
+            Conversion::Ist8310 | Conversion::Rm3100(_) => heapless::Vec::new(),
             Conversion::Qmc5883l(range) => {
                 heapless::Vec::from_iter([(0, qmc5883l::reg::CONF1, range.conf1_bits())])
             }
@@ -250,6 +255,10 @@ impl ChipSettings {
                 &mut image,
                 &mag_image::emit(qmc5883l::measurement(sample.mag, *range).0),
             ),
+            Conversion::Rm3100(cycle_counts) => copy(
+                &mut image,
+                &rm3100::image(rm3100::measurement(sample.mag, *cycle_counts)),
+            ),
         }
         image
     }
@@ -284,11 +293,15 @@ impl ChipSettings {
                     mag_ut: None,
                 }
             }
-            Conversion::Ist8310 | Conversion::Qmc5883l(_) => {
-                let raw = mag_image::parse(image.try_into().ok()?);
+            Conversion::Ist8310 | Conversion::Qmc5883l(_) | Conversion::Rm3100(_) => {
                 let mag = match self.conversion {
-                    Conversion::Qmc5883l(range) => qmc5883l::field_ut(raw, range),
-                    _ => ist8310::field_ut(raw),
+                    Conversion::Qmc5883l(range) => {
+                        qmc5883l::field_ut(mag_image::parse(image.try_into().ok()?), range)
+                    }
+                    Conversion::Rm3100(cycle_counts) => {
+                        rm3100::field_ut(rm3100::parse_image(image.try_into().ok()?), cycle_counts)
+                    }
+                    _ => ist8310::field_ut(mag_image::parse(image.try_into().ok()?)),
                 };
                 Reading {
                     acc: [0.0; 3],

@@ -242,6 +242,31 @@ pub fn data_bytes(raw: i32) -> [u8; 3] {
     [a, b, c]
 }
 
+/// Bytes of one register image: the result registers MX..=MZ (x, y, z, 24-bit big-endian) at
+/// the cycle counts the image was computed for.
+pub const IMAGE_LEN: usize = 9;
+
+/// The image (MX..=MZ) of results x, y, z.
+pub fn image(raw: [i32; 3]) -> [u8; IMAGE_LEN] {
+    let [x, y, z] = raw.map(data_bytes);
+    [x[0], x[1], x[2], y[0], y[1], y[2], z[0], z[1], z[2]]
+}
+
+/// The results x, y, z of an image.
+pub fn parse_image(image: &[u8; IMAGE_LEN]) -> [i32; 3] {
+    let [a, b, c, d, e, f, g, h, i] = *image;
+    [
+        from_data_bytes([a, b, c]),
+        from_data_bytes([d, e, f]),
+        from_data_bytes([g, h, i]),
+    ]
+}
+
+/// The field in µT (chip axes) results stand for at `cycle_counts`.
+pub fn field_ut(raw: [i32; 3], cycle_counts: [u16; 3]) -> [f64; 3] {
+    core::array::from_fn(|i| f64::from(raw[i]) / f64::from(lsb_per_ut(cycle_counts[i])))
+}
+
 /// A result from its three bytes, sign-extended (what a driver computes).
 pub fn from_data_bytes(bytes: [u8; 3]) -> i32 {
     i32::from_be_bytes([bytes[0], bytes[1], bytes[2], 0]) >> 8

@@ -5,8 +5,21 @@
 use margemu_protocol::regmap::rm3100::{next_address, reg};
 
 use super::super::spi_phase::{SpiPhase, SpiRegisters};
-use super::super::{I2cTarget, SpiTarget};
+use super::super::{Bus, I2cTarget, RegisterWrite, SpiTarget};
 use super::Rm3100;
+
+impl Rm3100 {
+    /// Puts a write of the device under test in the write log.
+    fn log_write(&mut self, bus: Bus, register: u8, value: u8) {
+        let device = self.address;
+        self.log.push(RegisterWrite {
+            bus,
+            device,
+            register,
+            value,
+        });
+    }
+}
 
 impl SpiRegisters for Rm3100 {
     fn prefetch(&mut self, addr: u8) -> u8 {
@@ -16,6 +29,7 @@ impl SpiRegisters for Rm3100 {
         self.commit_read(addr);
     }
     fn store(&mut self, addr: u8, value: u8) {
+        self.log_write(Bus::Spi, addr, value);
         self.write_byte(addr, value);
     }
     fn burst_next(&self, addr: u8) -> u8 {
@@ -65,6 +79,7 @@ impl I2cTarget for Rm3100 {
         self.clear_on_write(); // DRC0: at the first data byte (see the module docs)
         let addr = self.pointer;
         self.pointer = next_address(addr);
+        self.log_write(Bus::I2c, addr, byte);
         self.write_byte(addr, byte)
     }
 

@@ -3,7 +3,7 @@
 
 use margemu_protocol::regmap::rm3100::{self as map, bits};
 
-use super::Rm3100;
+use super::{Held, Rm3100};
 
 /// What the chip is doing.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -185,9 +185,12 @@ impl Rm3100 {
 
     /// Converts the held field on `axis` into its three result bytes, kept until [`Self::publish`].
     fn latch_axis(&mut self, axis: usize, seq: &Sequence) {
-        let field = self.field_ut.get(axis).copied().unwrap_or(0.0);
         let cc = seq.cycle_counts.get(axis).copied().unwrap_or(0);
-        let bytes = map::data_bytes(map::axis_to_raw(field, cc));
+        let raw = match self.held {
+            Held::Field(field) => map::axis_to_raw(field.get(axis).copied().unwrap_or(0.0), cc),
+            Held::Raw(raw) => raw.get(axis).copied().unwrap_or(0),
+        };
+        let bytes = map::data_bytes(raw);
         if let Some(slot) = self.pending.get_mut(3 * axis..3 * axis + 3) {
             for (d, b) in slot.iter_mut().zip(bytes) {
                 *d = b;

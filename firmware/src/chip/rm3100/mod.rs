@@ -77,13 +77,14 @@
 //! assert_eq!(mag.peek(0x34), 0x00, "reading the results cleared DRDY");
 //! ```
 
+mod boundary;
 mod bus;
 mod measure;
 
 use margemu_protocol::regmap::rm3100::{self as map, bits, reg, reset};
 
 use super::spi_phase::SpiPhase;
-use super::PhysicalSample;
+use super::{PhysicalSample, WriteLog};
 use measure::Run;
 
 /// The RM3100.
@@ -104,7 +105,7 @@ pub struct Rm3100 {
     pending: [u8; 9],
     run: Run,
     now_ns: u64,
-    field_ut: [f32; 3],
+    held: Held,
     strict_cmm: bool,
     pointer: u8,
     expect_register: bool,
@@ -112,6 +113,21 @@ pub struct Rm3100 {
     /// A result byte already went out in this transaction (DRC1 and NACK2 act on the first).
     results_read: bool,
     spi: SpiPhase,
+    log: WriteLog<RM3100_WRITE_LOG_LEN>,
+}
+
+/// Register writes the RM3100 keeps for the link.
+const RM3100_WRITE_LOG_LEN: usize = 32;
+
+/// What the RM3100 senses until the next latch: a field (converted at each axis's cycle count
+/// when that axis is measured) or an image's results (at the cycle counts the host predicted,
+/// copied as they are).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Held {
+    /// µT, chip axes.
+    Field([f32; 3]),
+    /// Results x, y, z.
+    Raw([i32; 3]),
 }
 
 impl Default for Rm3100 {
@@ -144,13 +160,14 @@ impl Rm3100 {
             pending: [0; 9],
             run: Run::Idle,
             now_ns: 0,
-            field_ut: [0.0; 3],
+            held: Held::Field([0.0; 3]),
             strict_cmm: false,
             pointer: 0,
             expect_register: false,
             addressed: false,
             results_read: false,
             spi: SpiPhase::Idle,
+            log: WriteLog::new(),
         }
     }
 
@@ -170,9 +187,9 @@ impl Rm3100 {
         matches!(self.run, Run::Continuous { .. })
     }
 
-    /// The field (µT, chip axes) the chip senses until the next [`Rm3100::latch_at`].
-    pub fn held_field(&self) -> [f32; 3] {
-        self.field_ut
+    /// What the chip senses until the next latch.
+    pub fn held(&self) -> Held {
+        self.held
     }
 
     /// The cycle counts of x, y, z.
@@ -228,8 +245,23 @@ impl Rm3100 {
         if now > 0 {
             self.run_until(now - 1);
         }
-        self.field_ut = sample.mag;
+        self.held = Held::Field(sample.mag);
         self.advance(now);
+    }
+
+    /// [`Rm3100::latch_at`] with an image's results (see [`Held::Raw`]).
+    pub fn latch_raw_at(&mut self, raw: [i32; 3], now_ns: u64) {
+        let now = self.now_ns.max(now_ns);
+        if now > 0 {
+            self.run_until(now - 1);
+        }
+        self.held = Held::Raw(raw);
+        self.advance(now);
+    }
+
+    /// The chip's clock.
+    pub fn now_ns(&self) -> u64 {
+        self.now_ns
     }
 
     /// Moves the chip's clock to `now_ns` (never backwards), completing what is due by then.
