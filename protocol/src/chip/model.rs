@@ -11,6 +11,8 @@ pub enum Family {
     Mpu6xxx,
     /// TDK InvenSense ICM-42688-P ([`crate::regmap::icm42688p`]).
     Icm42688p,
+    /// Bosch BMI270 ([`crate::regmap::bmi270`]).
+    Bmi270,
 }
 
 /// An emulated chip model. Its wire code ([`ChipModel::code`]) is the bit of
@@ -29,16 +31,19 @@ pub enum ChipModel {
     Icm20602 = 3,
     /// TDK InvenSense ICM-42688-P, WHO_AM_I 0x47.
     Icm42688p = 4,
+    /// Bosch BMI270, CHIP_ID 0x24.
+    Bmi270 = 5,
 }
 
 impl ChipModel {
     /// Every model, in code order.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 6] = [
         Self::Mpu9250,
         Self::Mpu6500,
         Self::Mpu6000,
         Self::Icm20602,
         Self::Icm42688p,
+        Self::Bmi270,
     ];
 
     /// The model's code on the link.
@@ -59,6 +64,7 @@ impl ChipModel {
             Self::Mpu6000 => "mpu6000",
             Self::Icm20602 => "icm20602",
             Self::Icm42688p => "icm42688p",
+            Self::Bmi270 => "bmi270",
         }
     }
 
@@ -70,6 +76,7 @@ impl ChipModel {
             Self::Mpu6000 => "MPU-6000",
             Self::Icm20602 => "ICM-20602",
             Self::Icm42688p => "ICM-42688-P",
+            Self::Bmi270 => "BMI270",
         }
     }
 
@@ -89,11 +96,13 @@ impl ChipModel {
     pub const fn family(self) -> Family {
         match self {
             Self::Icm42688p => Family::Icm42688p,
+            Self::Bmi270 => Family::Bmi270,
             _ => Family::Mpu6xxx,
         }
     }
 
-    /// The WHO_AM_I value of the part itself (the first of [`ChipModel::identities`]).
+    /// The WHO_AM_I value of the part itself (the first of [`ChipModel::identities`]; the
+    /// BMI270's CHIP_ID).
     pub const fn who_am_i(self) -> u8 {
         self.identities()[0]
     }
@@ -107,6 +116,7 @@ impl ChipModel {
             Self::Mpu6000 => &[0x68],
             Self::Icm20602 => &[0x12],
             Self::Icm42688p => &[0x47],
+            Self::Bmi270 => &[crate::regmap::bmi270::CHIP_ID],
         }
     }
 
@@ -115,14 +125,18 @@ impl ChipModel {
         Buses(Buses::SPI.0 | Buses::I2C.0)
     }
 
-    /// The 7-bit I2C addresses the part can be strapped to (AD0 low first).
+    /// The 7-bit I2C addresses the part can be strapped to (AD0 or, on the BMI270, SDO low
+    /// first).
     pub const fn i2c_addresses(self) -> &'static [u8] {
-        &[0x68, 0x69]
+        match self {
+            Self::Bmi270 => &crate::regmap::bmi270::I2C_ADDRESSES,
+            _ => &[0x68, 0x69],
+        }
     }
 
     /// Register files of the model, as [`RegisterOverride::file`](crate::link::RegisterOverride)
     /// numbers them: the MPU-9250's die (0) and its AK8963 (1); the ICM-42688-P's banks 0–4;
-    /// one file otherwise.
+    /// one file otherwise (the BMI270's one page of 128 registers).
     pub const fn register_files(self) -> u8 {
         match self {
             Self::Mpu9250 => 2,
@@ -157,6 +171,16 @@ impl ChipModel {
                 "FIFO: 8-, 16- and 20-byte packets with headers, 20-bit data, timestamps,                  count in bytes or records, lost packets, overflow, watermark",
                 "INT1/INT2: data ready, FIFO threshold and full, reset done; pulse or latched",
             ],
+            Family::Bmi270 => &[
+                "every register with its reset value, write mask and read-back (one page)",
+                "SPI with its dummy byte and the switch from I2C on a chip-select rising edge; I2C",
+                "configuration upload (328-byte and 8 KB files, INIT_ADDR chunks), INTERNAL_STATUS; \
+                 no data before init_ok",
+                "16-bit little-endian data at the configured ranges; accel at its own ODR; \
+                 temperature every 10 ms; SENSORTIME",
+                "FIFO: headered and headerless frames, FIFO_DOWNS, stop-on-full or fifo_err, flush",
+                "INT1/INT2: data ready, pulsed (156.25 µs) or latched, level, open drain, output enable",
+            ],
         }
     }
 
@@ -171,6 +195,12 @@ impl ChipModel {
                 "the anti-alias and UI filters' effect on the data (settings are stored)",
                 "APEX motion features, self-test, external clock (CLKIN), FSYNC",
             ],
+            Family::Bmi270 => &[
+                "the filters' effect on the data, pre-filtered FIFO data (settings are stored)",
+                "the configuration file's features (FEATURES pages are storage), the time init takes",
+                "FIFO sensor time, skip and configuration frames, watermark and full interrupts",
+                "low-power timing (adv_power_save is stored), the auxiliary interface, self-test, offsets",
+            ],
         }
     }
 
@@ -182,6 +212,7 @@ impl ChipModel {
                 crate::regmap::mpu6xxx::image::SENSORS_LEN
             }
             Self::Icm42688p => crate::regmap::icm42688p::image::IMAGE_LEN,
+            Self::Bmi270 => crate::regmap::bmi270::image::IMAGE_LEN,
         }
     }
 
@@ -190,6 +221,8 @@ impl ChipModel {
     /// divided by 1 + SMPLRT_DIV (RM-MPU-6000A section 4.2). MPU-6500, MPU-9250, ICM-20602:
     /// 32 kHz (FCHOICE_B), 8 kHz (DLPF_CFG 0 or 7), or 1 kHz / (1 + SMPLRT_DIV) (the divider
     /// applies only with the DLPF on; RM-MPU-9250A section 4.4). ICM-42688-P: its ODR codes.
+    /// BMI270: its gyro ODR codes, 25 Hz to 3.2 kHz (the served rate is the gyro's; the
+    /// accelerometer runs at its own ODR, at most 1.6 kHz).
     pub fn has_output_rate(self, rate_hz: f64) -> bool {
         let close = |r: f64| (r - rate_hz).abs() <= 1e-9 * r;
         let divided = |base: f64| (1..=256u32).any(|n| close(base / f64::from(n)));
@@ -199,6 +232,7 @@ impl ChipModel {
                 close(32_000.0) || close(8_000.0) || divided(1_000.0)
             }
             Self::Icm42688p => crate::regmap::icm42688p::Odr::gyro_of_hz(rate_hz).is_some(),
+            Self::Bmi270 => crate::regmap::bmi270::Odr::gyro_of_hz(rate_hz).is_some(),
         }
     }
 }
@@ -219,7 +253,8 @@ mod tests {
             Some(ChipModel::Icm42688p)
         );
         assert_eq!(ChipModel::from_name("MPU_6000"), Some(ChipModel::Mpu6000));
-        assert_eq!(ChipModel::from_name("bmi270"), None);
+        assert_eq!(ChipModel::from_name("BMI-270"), Some(ChipModel::Bmi270));
+        assert_eq!(ChipModel::from_name("bmi999"), None);
         assert_eq!(ChipModel::from_name("an-overlong-name-of-no-chip"), None);
         assert_eq!(ChipModel::from_code(200), None);
     }
@@ -232,5 +267,18 @@ mod tests {
         assert!(ChipModel::Icm42688p.has_output_rate(8000.0));
         assert!(ChipModel::Icm42688p.has_output_rate(12.5));
         assert!(!ChipModel::Icm42688p.has_output_rate(300.0));
+        assert!(ChipModel::Bmi270.has_output_rate(3200.0));
+        assert!(ChipModel::Bmi270.has_output_rate(25.0));
+        assert!(!ChipModel::Bmi270.has_output_rate(1000.0));
+        assert!(!ChipModel::Bmi270.has_output_rate(12.5));
+    }
+
+    #[test]
+    fn the_bmi270() {
+        let m = ChipModel::Bmi270;
+        assert_eq!((m.code(), m.who_am_i(), m.image_len()), (5, 0x24, 14));
+        assert_eq!((m.family(), m.register_files()), (Family::Bmi270, 1));
+        assert_eq!(m.i2c_addresses(), &[0x68, 0x69]);
+        assert!(!m.has_magnetometer());
     }
 }

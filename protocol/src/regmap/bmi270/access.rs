@@ -24,7 +24,7 @@ const fn spec(addr: u8) -> Option<(u8, u8)> {
         reg::GYR_CONF => (0xA9, 0xFF),
         reg::GYR_RANGE => (0x00, 0x0F),
         0x44 => (0x46, 0xFF), // AUX_CONF
-        0x45 => (0x88, 0xFF), // FIFO_DOWNS
+        reg::FIFO_DOWNS => (0x88, 0xFF),
         0x46 => (0x00, 0xFF), // FIFO_WTM_0
         0x47 => (0x02, 0x1F), // FIFO_WTM_1
         reg::FIFO_CONFIG_0 => (0x02, 0x03),
@@ -36,8 +36,8 @@ const fn spec(addr: u8) -> Option<(u8, u8)> {
         0x4E => (0x4C, 0xFF),                     // AUX_WR_ADDR
         0x4F => (0x02, 0xFF),                     // AUX_WR_DATA
         0x52 => (0x00, 0xFF),                     // ERR_REG_MSK
-        reg::INT1_IO_CTRL | 0x54 => (0x00, 0x1E), // INT1/INT2_IO_CTRL
-        0x55 => (0x00, 0x01),                     // INT_LATCH
+        reg::INT1_IO_CTRL | reg::INT2_IO_CTRL => (0x00, 0x1E),
+        reg::INT_LATCH => (0x00, 0x01),
         0x56..=reg::INT_MAP_DATA => (0x00, 0xFF), // INT1/INT2_MAP_FEAT, INT_MAP_DATA
         reg::INIT_CTRL => (0x00, 0xFF),
         reg::INIT_ADDR_0 => (0x00, 0x0F),
