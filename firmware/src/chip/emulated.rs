@@ -19,6 +19,7 @@
 
 use margemu_protocol::chip::{ChipModel, ChipSettings, PhysicalSample};
 
+use super::bmi270::{self, Bmi270};
 use super::icm42688p::{self, Icm42688p};
 use super::mpu6xxx::{self, Mpu6xxx, Variant};
 use super::{I2cTarget, RegisterWrite, SpiTarget};
@@ -81,6 +82,12 @@ pub trait Chip: SpiTarget + I2cTarget {
             addr = self.spi_next_address(addr);
         }
     }
+    /// The byte an SPI read clocks out before the addressed register's value, if reads have
+    /// one now (the BMI270's dummy byte, in SPI mode); [`Chip::spi_read_burst`] includes it.
+    /// The default: none.
+    fn spi_read_dummy(&self) -> Option<u8> {
+        None
+    }
     /// The 7-bit I2C addresses the chip acknowledges now, at most two (a board's I2C peripheral
     /// owns two: the MPU-9250's own address, and the AK8963's in bypass mode). The default is
     /// [`Chip::i2c_address`] alone.
@@ -112,6 +119,8 @@ pub enum EmulatedChip {
     Mpu6xxx(Mpu6xxx),
     /// The TDK InvenSense ICM-42688-P.
     Icm42688p(Icm42688p),
+    /// The Bosch BMI270.
+    Bmi270(Bmi270),
 }
 
 impl Default for EmulatedChip {
@@ -130,11 +139,19 @@ impl EmulatedChip {
             return None;
         }
         let ad0 = model.i2c_addresses().get(1) == Some(&i2c_address);
-        if model == ChipModel::Icm42688p {
-            return Some(Self::Icm42688p(Icm42688p::with_config(icm42688p::Config {
-                ad0,
-                who_am_i,
-            })));
+        match model {
+            ChipModel::Icm42688p => {
+                return Some(Self::Icm42688p(Icm42688p::with_config(icm42688p::Config {
+                    ad0,
+                    who_am_i,
+                })))
+            }
+            ChipModel::Bmi270 => {
+                return Some(Self::Bmi270(Bmi270::with_config(bmi270::Config {
+                    sdo: ad0,
+                })))
+            }
+            _ => {}
         }
         let variant = Variant::for_model(model, who_am_i)?;
         Some(Self::Mpu6xxx(Mpu6xxx::with_config(mpu6xxx::Config {
@@ -147,7 +164,8 @@ impl EmulatedChip {
     /// The models this firmware emulates.
     pub fn models() -> impl Iterator<Item = ChipModel> {
         ChipModel::ALL.into_iter().filter(|m| {
-            *m == ChipModel::Icm42688p || Variant::for_model(*m, m.who_am_i()).is_some()
+            matches!(m, ChipModel::Icm42688p | ChipModel::Bmi270)
+                || Variant::for_model(*m, m.who_am_i()).is_some()
         })
     }
 }
@@ -158,6 +176,7 @@ macro_rules! each_chip {
         match $self {
             EmulatedChip::Mpu6xxx($chip) => $call,
             EmulatedChip::Icm42688p($chip) => $call,
+            EmulatedChip::Bmi270($chip) => $call,
         }
     };
 }
@@ -246,6 +265,9 @@ impl Chip for EmulatedChip {
     }
     fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
         each_chip!(self, c => c.spi_read_burst(start, out))
+    }
+    fn spi_read_dummy(&self) -> Option<u8> {
+        each_chip!(self, c => c.spi_read_dummy())
     }
     fn i2c_addresses_now(&self) -> [Option<u8>; 2] {
         each_chip!(self, c => c.i2c_addresses_now())

@@ -36,6 +36,15 @@ pub fn spi_chip() -> Bmi270 {
     c
 }
 
+/// A chip in SPI mode with the 328-byte configuration file uploaded: INTERNAL_STATUS init_ok,
+/// the sensors run once PWR_CTRL enables them.
+pub fn ready_chip() -> Bmi270 {
+    let mut c = spi_chip();
+    upload(&mut c, &config_file(328));
+    assert_eq!(read1(&mut c, 0x21), 0x01, "init_ok");
+    c
+}
+
 /// The drivers' dummy read of CHIP_ID: one chip-select edge.
 pub fn dummy_read(chip: &mut impl SpiTarget) {
     spi(chip, &[0x80, 0x00]);

@@ -322,7 +322,12 @@ mod tests {
         // bits of the CONF registers keep their power-on values (0xA9, 0xA8).
         assert_eq!(
             writes,
-            [(0, 0x41, 0x03), (0, 0x43, 0x02), (0, 0x42, 0xAD), (0, 0x40, 0xAC)]
+            [
+                (0, 0x41, 0x03),
+                (0, 0x43, 0x02),
+                (0, 0x42, 0xAD),
+                (0, 0x40, 0xAC)
+            ]
         );
         // At the power-on ranges and the power-on rates (gyro 200 Hz, accel 100 Hz) only the
         // accel ODR moves up to the gyro's.
@@ -367,6 +372,11 @@ mod tests {
         invalid[13] = 0x80;
         assert!(s.decode(&invalid).unwrap().temp_c.is_nan());
         assert_eq!(s.decode(&[0; 13]), None);
-        assert_eq!(ChipSettings::power_on(ChipModel::Bmi270).full_scale().accel_g, 8.0);
+        assert_eq!(
+            ChipSettings::power_on(ChipModel::Bmi270)
+                .full_scale()
+                .accel_g,
+            8.0
+        );
     }
 }

@@ -29,13 +29,13 @@ const fn spec(addr: u8) -> Option<(u8, u8)> {
         0x47 => (0x02, 0x1F), // FIFO_WTM_1
         reg::FIFO_CONFIG_0 => (0x02, 0x03),
         reg::FIFO_CONFIG_1 => (0x10, 0xFF),
-        0x4A => (0x00, 0),                        // SATURATION
-        0x4B => (0x20, 0xFE),                     // AUX_DEV_ID
-        0x4C => (0x83, 0xCF),                     // AUX_IF_CONF
-        0x4D => (0x42, 0xFF),                     // AUX_RD_ADDR
-        0x4E => (0x4C, 0xFF),                     // AUX_WR_ADDR
-        0x4F => (0x02, 0xFF),                     // AUX_WR_DATA
-        0x52 => (0x00, 0xFF),                     // ERR_REG_MSK
+        0x4A => (0x00, 0),    // SATURATION
+        0x4B => (0x20, 0xFE), // AUX_DEV_ID
+        0x4C => (0x83, 0xCF), // AUX_IF_CONF
+        0x4D => (0x42, 0xFF), // AUX_RD_ADDR
+        0x4E => (0x4C, 0xFF), // AUX_WR_ADDR
+        0x4F => (0x02, 0xFF), // AUX_WR_DATA
+        0x52 => (0x00, 0xFF), // ERR_REG_MSK
         reg::INT1_IO_CTRL | reg::INT2_IO_CTRL => (0x00, 0x1E),
         reg::INT_LATCH => (0x00, 0x01),
         0x56..=reg::INT_MAP_DATA => (0x00, 0xFF), // INT1/INT2_MAP_FEAT, INT_MAP_DATA
