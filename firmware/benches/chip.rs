@@ -142,12 +142,22 @@ fn spi_write(chip: &mut EmulatedChip, bytes: &[u8]) {
 }
 
 /// `model` at power-on with its sensors on (MPU family: PWR_MGMT_1 = 0x01, awake on the PLL;
-/// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise).
+/// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise; BMI270: the dummy read, a
+/// 328-byte configuration upload, PWR_CTRL = 0x0E).
 fn powered(model: ChipModel) -> EmulatedChip {
     let mut chip = EmulatedChip::new(model, model.who_am_i(), 0x68).expect("the model's identity");
     match model.family() {
         Family::Mpu6xxx => spi_write(&mut chip, &[0x6B, 0x01]),
         Family::Icm42688p => spi_write(&mut chip, &[0x4E, 0x0F]),
+        Family::Bmi270 => {
+            spi_write(&mut chip, &[0x80, 0x00]);
+            spi_write(&mut chip, &[0x59, 0x00]);
+            let mut upload = [0xC8u8; 1 + 328];
+            upload[0] = 0x5E;
+            spi_write(&mut chip, &upload);
+            spi_write(&mut chip, &[0x59, 0x01]);
+            spi_write(&mut chip, &[0x7D, 0x0E]);
+        }
     }
     chip
 }
@@ -157,6 +167,7 @@ fn burst_start(model: ChipModel) -> u8 {
     match model.family() {
         Family::Mpu6xxx => 0x3B,   // ACCEL_XOUT_H
         Family::Icm42688p => 0x1D, // TEMP_DATA1
+        Family::Bmi270 => 0x0C,    // ACC_X_LSB, behind the dummy byte
     }
 }
 

@@ -8,10 +8,15 @@
 
 #![allow(missing_docs)]
 
+mod boundary;
 mod bus;
 mod data;
 mod drivers;
+mod fc;
 mod fifo;
+mod i2c;
+mod interrupts;
+mod rates;
 mod upload;
 
 #[path = "../common/transactions.rs"]

@@ -29,6 +29,7 @@ impl BenchChip for &mut Shadowed {
         match self.chip() {
             EmulatedChip::Mpu6xxx(chip) => chip.is_running(),
             EmulatedChip::Icm42688p(chip) => chip.is_running(),
+            EmulatedChip::Bmi270(chip) => chip.sample_period_ns().is_some(),
         }
     }
     fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64) {

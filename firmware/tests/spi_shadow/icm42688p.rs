@@ -28,7 +28,9 @@ impl fc::Rig for Shadowed {
     fn image_config(&self) -> ImageConfig {
         match self.chip() {
             EmulatedChip::Icm42688p(chip) => chip.image_config(),
-            EmulatedChip::Mpu6xxx(_) => panic!("an ICM-42688-P sequence on another chip"),
+            EmulatedChip::Mpu6xxx(_) | EmulatedChip::Bmi270(_) => {
+                panic!("an ICM-42688-P sequence on another chip")
+            }
         }
     }
     fn loop_starts(&mut self) {
