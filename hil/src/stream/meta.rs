@@ -52,8 +52,9 @@ pub(super) fn metadata(
                 gyro_offset: i.gyro_offset,
                 accel_offset: i.accel_offset,
             }),
-            // The ICM-42688-P's conversion is its full scales, already in `[chip]`.
-            Conversion::Icm42688p(_) => None,
+            // The ICM-42688-P's and the BMI270's conversions are their full scales, already in
+            // `[chip]`.
+            Conversion::Icm42688p(_) | Conversion::Bmi270(_) => None,
         },
         scene_text: scene.text.clone(),
         device: None,

@@ -107,6 +107,15 @@ impl ChipModel {
         self.identities()[0]
     }
 
+    /// The name of the identity register the datasheet gives ([`ChipModel::identities`] are
+    /// its values): `"WHO_AM_I"`, the BMI270's `"CHIP_ID"`.
+    pub const fn identity_register(self) -> &'static str {
+        match self {
+            Self::Bmi270 => "CHIP_ID",
+            _ => "WHO_AM_I",
+        }
+    }
+
     /// Every WHO_AM_I value the model can be told to answer (identity variants of one register
     /// map: the MPU-9255 and the 0x68 parts behave as the MPU-9250).
     pub const fn identities(self) -> &'static [u8] {
@@ -278,6 +287,7 @@ mod tests {
         let m = ChipModel::Bmi270;
         assert_eq!((m.code(), m.who_am_i(), m.image_len()), (5, 0x24, 14));
         assert_eq!((m.family(), m.register_files()), (Family::Bmi270, 1));
+        assert_eq!(m.identity_register(), "CHIP_ID");
         assert_eq!(m.i2c_addresses(), &[0x68, 0x69]);
         assert!(!m.has_magnetometer());
     }

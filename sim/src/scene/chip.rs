@@ -113,7 +113,7 @@ impl ChipSetup {
             ..Configure::new(self.model, rate)
         };
         for (file, register, value) in self.settings.config_writes(rate.as_hz_f64()) {
-            // At most two writes: always within MAX_OVERRIDES.
+            // At most four writes: always within MAX_OVERRIDES.
             let _ = cfg.overrides.push(RegisterOverride {
                 file,
                 register,
