@@ -38,6 +38,7 @@
 mod ak8963;
 pub mod bmi270;
 mod emulated;
+mod i2c_pointer;
 pub mod icm42688p;
 pub mod ist8310;
 pub mod mpu6xxx;
