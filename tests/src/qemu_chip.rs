@@ -11,7 +11,7 @@
 //!   the Configure's overrides wrote into its emulated chip. The host predicts the same images
 //!   on x86-64 ([`ModelStream`]).
 //!
-//! The scene is [`motion_scene_text`](crate::motion_scene_text) (sines on all six joints, the
+//! The scene is [`motion_scene_text`] (sines on all six joints, the
 //! paper's noise, biases, hard iron, a warming die) with the case's `[chip]`.
 
 use std::path::Path;
