@@ -151,8 +151,9 @@ fn spi_write(chip: &mut EmulatedChip, bytes: &[u8]) {
 }
 
 /// `model` at power-on with its sensors on (MPU family: PWR_MGMT_1 = 0x01, awake on the PLL;
-/// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise; QMC5883L: CONF1 = 0x0D,
-/// continuous at 200 Hz; IST8310: single measurements, triggered by its reader).
+/// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise; BMI270: the dummy read, a
+/// 328-byte configuration upload, PWR_CTRL = 0x0E; QMC5883L: CONF1 = 0x0D, continuous at
+/// 200 Hz; IST8310: single measurements, triggered by its reader; RM3100: continuous).
 fn powered(model: ChipModel) -> EmulatedChip {
     let address = model.i2c_addresses()[0];
     let mut chip =
@@ -160,6 +161,15 @@ fn powered(model: ChipModel) -> EmulatedChip {
     match model.family() {
         Family::Mpu6xxx => spi_write(&mut chip, &[0x6B, 0x01]),
         Family::Icm42688p => spi_write(&mut chip, &[0x4E, 0x0F]),
+        Family::Bmi270 => {
+            spi_write(&mut chip, &[0x80, 0x00]);
+            spi_write(&mut chip, &[0x59, 0x00]);
+            let mut upload = [0xC8u8; 1 + 328];
+            upload[0] = 0x5E;
+            spi_write(&mut chip, &upload);
+            spi_write(&mut chip, &[0x59, 0x01]);
+            spi_write(&mut chip, &[0x7D, 0x0E]);
+        }
         Family::Qmc5883l => assert!(chip.write_register(0, 0x09, 0x0D)),
         Family::Ist8310 => {}
         // Continuous measurement of x, y, z at TMRC's reset rate.

@@ -105,6 +105,7 @@ fn scenes_lists_every_fixture_scene_and_prints_its_text() {
         "{text}"
     );
     assert!(line("static ").contains(" static     mpu9250 "), "{text}");
+    assert!(line("bmi270 ").contains(" kinematic  bmi270 "), "{text}");
 }
 
 #[test]
@@ -176,7 +177,7 @@ fn demo_without_a_scene_runs_the_case_study_from_an_empty_directory() {
 #[test]
 fn an_argument_that_is_neither_a_file_nor_a_built_in_scene_lists_the_names() {
     let dir = empty_dir("unknown");
-    let names = "case-study, figure3, gimbal-lock, icm42688p, mpu6000, rig, static";
+    let names = "bmi270, case-study, figure3, gimbal-lock, icm42688p, mpu6000, rig, static";
     for (arg, reason) in [
         (
             "figure4",

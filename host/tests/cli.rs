@@ -162,6 +162,7 @@ fn chips_lists_every_model_with_its_facts() {
         "MPU-6000",
         "ICM-20602",
         "ICM-42688-P",
+        "BMI270",
     ] {
         assert!(
             text.contains(&format!("{part} ([chip] model")),
@@ -178,10 +179,22 @@ fn chips_lists_every_model_with_its_facts() {
     );
     assert!(text.contains("not emulated:"), "{text}");
     let out = margemu(&["chips", "bmi270"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for line in [
+        "CHIP_ID:      0x24",
+        "buses:        SPI, I2C at 0x68, 0x69",
+        "accel ranges: ± 2, 4, 8, 16 g (power-on ±8 g)",
+        "gyro ranges:  ± 125, 250, 500, 1000, 2000 °/s (power-on ±2000 °/s)",
+        "output rates: 3200 Hz, 1600 Hz, 800 Hz, 400 Hz, 200 Hz, 100 Hz, 50 Hz, 25 Hz (the gyro's",
+        "image:        14 bytes",
+    ] {
+        assert!(text.contains(line), "{line}: {text}");
+    }
+    let out = margemu(&["chips", "bmi999"]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("no chip model \"bmi270\"; margemu emulates mpu9250"),
+        err.contains("no chip model \"bmi999\"; margemu emulates mpu9250"),
         "{err}"
     );
 }

@@ -60,6 +60,11 @@ fn icm42688p_fixture_is_served_as_predicted_in_both_source_modes() {
 }
 
 #[test]
+fn bmi270_fixture_is_served_as_predicted_in_both_source_modes() {
+    check_chip_fixture("bmi270.toml", "bmi270", 3200, 14);
+}
+
+#[test]
 fn mpu6000_fixture_is_served_as_predicted_in_both_source_modes() {
     check_chip_fixture("mpu6000.toml", "mpu6000", 1000, 14);
 }

@@ -167,7 +167,7 @@ fn chip_table_errors_are_located() {
     assert_error(
         &chip("model = \"bmi999\"\n"),
         "5:9",
-        "no chip model \"bmi999\"; margemu emulates mpu9250, mpu6500, mpu6000, icm20602, icm42688p",
+        "no chip model \"bmi999\"; margemu emulates mpu9250, mpu6500, mpu6000, icm20602, icm42688p, bmi270",
     );
     assert_error(&chip("bus = \"can\"\n"), "5:7", "unknown variant `can`");
     assert_error(
@@ -209,6 +209,21 @@ fn chip_table_errors_are_located() {
         "duration = 1.0\nrate = 300.0\nseed = 1\n[chip]\nmodel = \"icm42688p\"\n",
         "2:8",
         "300 Hz is not an output rate of the ICM-42688-P",
+    );
+    assert_error(
+        "duration = 1.0\nrate = 8000.0\nseed = 1\n[chip]\nmodel = \"bmi270\"\n",
+        "2:8",
+        "8000 Hz is not an output rate of the BMI270",
+    );
+    assert_error(
+        &chip("model = \"bmi270\"\nwho_am_i = 0x47\n"),
+        "6:12",
+        "the BMI270 answers 0x24, not 0x47",
+    );
+    assert_error(
+        &chip("model = \"bmi270\"\ngyro_range = 4000\n"),
+        "6:14",
+        "the BMI270 has no ±4000 °/s range; its ranges are ± 125, 250, 500, 1000, 2000 °/s",
     );
 }
 

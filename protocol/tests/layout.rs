@@ -53,7 +53,7 @@ fn chips_are_a_set_of_model_codes() {
     let all = ChipModel::ALL
         .into_iter()
         .fold(Chips::EMPTY, |c, m| c | Chips::of(m));
-    assert_eq!(all, Chips(0x1DF)); // code 5 is not taken yet
+    assert_eq!(all, Chips(0x1FF));
     assert!(all.models().eq(ChipModel::ALL));
     // Unknown bits (a newer device's models) are kept on the wire and skipped by `models`.
     let newer = Chips(0x8000_0000 | Chips::of(ChipModel::Icm42688p).0);
@@ -332,6 +332,7 @@ fn configure_names_the_chip() {
             (2, 14),
             (3, 14),
             (4, 32),
+            (5, 14),
             (6, 6),
             (7, 6),
             (8, 9)
@@ -353,7 +354,7 @@ fn configure_names_the_chip() {
     assert_eq!(b[21..], [1, 4, 0x7B, 0x02]);
     parses_back(Kind::Configure, &b, &m);
     // An unknown chip code is refused.
-    for code in [5, 0x80, 0xFF] {
+    for code in [9, 0x80, 0xFF] {
         let mut bad = b.clone();
         bad[0] = code;
         assert_eq!(

@@ -2,7 +2,8 @@
 //! where the fixtures live; [`qemu`] builds the QEMU board firmware and boots it; [`drive`] is a
 //! scripted link host for either source mode; [`model_source`] prepares a scene for source
 //! mode (b) and predicts its images; [`served`] checks the device's Served reports against a
-//! prediction; [`qemu_session`] runs and checks one QEMU session of either source mode.
+//! prediction; [`qemu_session`] runs and checks one QEMU session of either source mode;
+//! [`qemu_chip`] runs a chip model on the QEMU board in both.
 
 use std::path::{Path, PathBuf};
 
@@ -11,6 +12,7 @@ use margemu::scene::Scene;
 pub mod drive;
 pub mod model_source;
 pub mod qemu;
+pub mod qemu_chip;
 pub mod qemu_session;
 pub mod served;
 

@@ -242,4 +242,30 @@ mod tests {
             );
         }
     }
+
+    #[test]
+    fn a_bmi270_image_decodes_without_a_field() {
+        let fs = margemu_protocol::chip::FullScale {
+            accel_g: 16.0,
+            gyro_dps: 2000.0,
+        };
+        let meta = SessionMeta {
+            start_host_ns: 0,
+            chip: ChipSettings::with_full_scale(ChipModel::Bmi270, fs).unwrap(),
+            mag_ut_per_unit: 50.0,
+        };
+        let acc = [1.5f32, -30.0, 9.0];
+        let sample = margemu_protocol::chip::PhysicalSample {
+            acc,
+            ..Default::default()
+        };
+        let image = meta.chip.image(&sample);
+        assert_eq!(image.len(), 14);
+        let (a, m) = decode(&image, &meta).unwrap();
+        for i in 0..3 {
+            assert!((a[i] - f64::from(acc[i])).abs() < 9.81 / 2048.0, "{a:?}");
+        }
+        assert!(m.iter().all(|b| b.is_nan()), "no magnetometer: {m:?}");
+        assert_eq!(decode(&image[..13], &meta), None);
+    }
 }

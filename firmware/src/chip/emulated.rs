@@ -19,6 +19,7 @@
 
 use margemu_protocol::chip::{ChipModel, ChipSettings, PhysicalSample};
 
+use super::bmi270::{self, Bmi270};
 use super::icm42688p::{self, Icm42688p};
 use super::mpu6xxx::{self, Mpu6xxx, Variant};
 use super::{I2cTarget, Ist8310, Qmc5883l, RegisterWrite, Rm3100, SpiTarget};
@@ -81,6 +82,12 @@ pub trait Chip: SpiTarget + I2cTarget {
             addr = self.spi_next_address(addr);
         }
     }
+    /// The byte an SPI read clocks out before the addressed register's value, if reads have
+    /// one now (the BMI270's dummy byte, in SPI mode); [`Chip::spi_read_burst`] includes it.
+    /// The default: none.
+    fn spi_read_dummy(&self) -> Option<u8> {
+        None
+    }
     /// The 7-bit I2C addresses the chip acknowledges now, at most two (a board's I2C peripheral
     /// owns two: the MPU-9250's own address, and the AK8963's in bypass mode). The default is
     /// [`Chip::i2c_address`] alone.
@@ -112,6 +119,8 @@ pub enum EmulatedChip {
     Mpu6xxx(Mpu6xxx),
     /// The TDK InvenSense ICM-42688-P.
     Icm42688p(Icm42688p),
+    /// The Bosch BMI270.
+    Bmi270(Bmi270),
     /// The iSentek IST8310 magnetometer.
     Ist8310(Ist8310),
     /// The QST QMC5883L magnetometer.
@@ -143,6 +152,11 @@ impl EmulatedChip {
                     who_am_i,
                 })))
             }
+            ChipModel::Bmi270 => {
+                return Some(Self::Bmi270(Bmi270::with_config(bmi270::Config {
+                    sdo: ad0,
+                })))
+            }
             ChipModel::Ist8310 => return Some(Self::Ist8310(Ist8310::with_address(i2c_address))),
             ChipModel::Qmc5883l => {
                 return Some(Self::Qmc5883l(Qmc5883l::with_address(i2c_address)))
@@ -169,7 +183,11 @@ impl EmulatedChip {
         ChipModel::ALL.into_iter().filter(|m| {
             matches!(
                 m,
-                ChipModel::Icm42688p | ChipModel::Ist8310 | ChipModel::Qmc5883l | ChipModel::Rm3100
+                ChipModel::Icm42688p
+                    | ChipModel::Bmi270
+                    | ChipModel::Ist8310
+                    | ChipModel::Qmc5883l
+                    | ChipModel::Rm3100
             ) || Variant::for_model(*m, m.who_am_i()).is_some()
         })
     }
@@ -181,6 +199,7 @@ macro_rules! each_chip {
         match $self {
             EmulatedChip::Mpu6xxx($chip) => $call,
             EmulatedChip::Icm42688p($chip) => $call,
+            EmulatedChip::Bmi270($chip) => $call,
             EmulatedChip::Ist8310($chip) => $call,
             EmulatedChip::Qmc5883l($chip) => $call,
             EmulatedChip::Rm3100($chip) => $call,
@@ -272,6 +291,9 @@ impl Chip for EmulatedChip {
     }
     fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
         each_chip!(self, c => c.spi_read_burst(start, out))
+    }
+    fn spi_read_dummy(&self) -> Option<u8> {
+        each_chip!(self, c => c.spi_read_dummy())
     }
     fn i2c_addresses_now(&self) -> [Option<u8>; 2] {
         each_chip!(self, c => c.i2c_addresses_now())

@@ -26,8 +26,9 @@
 //! - [`Ak8963`] on its own, as an [`I2cTarget`];
 //! - [`Icm42688p`]: the TDK InvenSense ICM-42688-P (banks 0–4, 2 KB FIFO with 16- and 20-bit
 //!   packets, INT1/INT2);
-//! - [`bmi270::Bmi270`]: the Bosch BMI270 (SPI with its dummy byte and I2C-to-SPI switch, the
-//!   configuration upload, data registers and sensor time); not yet one of the [`EmulatedChip`]s.
+//! - [`Bmi270`]: the Bosch BMI270 (SPI with its dummy byte and I2C-to-SPI switch, I2C, the
+//!   configuration upload, data registers at the sensors' own rates, sensor time, the FIFO,
+//!   INT1/INT2 data ready);
 //! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer (I2C only);
 //! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer (I2C only); both share their
 //!   [`Chip`] boundary ([`magnetometer`]) and I2C front end ([`pointer_i2c`]).
@@ -38,6 +39,7 @@
 mod ak8963;
 pub mod bmi270;
 mod emulated;
+mod i2c_pointer;
 pub mod icm42688p;
 pub mod ist8310;
 pub mod magnetometer;
@@ -49,6 +51,7 @@ mod spi_phase;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
+pub use bmi270::Bmi270;
 pub use emulated::{spi_read_burst_on_copy, Chip, EmulatedChip};
 pub use icm42688p::Icm42688p;
 pub use ist8310::Ist8310;

@@ -26,7 +26,9 @@
 //! at the predicted address, is left to the DMA; any other read is taken over by the CPU
 //! ([`SpiPort::stop_stream`]), which serves the rest of the burst from the shadow, and whose
 //! first byte is right only if the takeover beat the data byte (slow clocks, or a controller
-//! that leaves a gap after the address byte). Writes are applied to the shadow at once
+//! that leaves a gap after the address byte). On a chip whose reads clock out a dummy byte
+//! before the data (the BMI270, [`Chip::spi_read_dummy`]) the stream and the takeover both
+//! begin with it. Writes are applied to the shadow at once
 //! ([`Shadow::write_through`]) so a read-back sees them.
 //!
 //! Every transaction is recorded as a [`Capture`] (MOSI bytes and the MISO bytes actually
@@ -129,6 +131,8 @@ pub struct Shadow {
     stream: [u8; STREAM_LEN],
     start: u8,
     generation: u32,
+    /// The chip's dummy byte ahead of a read's data ([`Chip::spi_read_dummy`]).
+    dummy: Option<u8>,
 }
 
 impl Default for Shadow {
@@ -148,6 +152,7 @@ impl Shadow {
             stream: [0; STREAM_LEN],
             start: 0,
             generation: 0,
+            dummy: None,
         }
     }
 
@@ -163,11 +168,13 @@ impl Shadow {
         }
         self.start = start & 0x7F;
         self.generation = generation;
+        self.dummy = chip.spi_read_dummy();
         self.stream[0] = ADDRESS_PHASE_MISO;
         chip.spi_read_burst(self.start, &mut self.stream[1..]);
     }
 
-    /// The value a read of `addr` returns (7 bits of address).
+    /// The value a read of `addr` returns (7 bits of address), behind the dummy byte on chips
+    /// with one ([`Shadow::dummy`]).
     pub fn read(&self, addr: u8) -> u8 {
         self.regs[usize::from(addr & 0x7F)]
     }
@@ -177,13 +184,30 @@ impl Shadow {
         self.next[usize::from(addr & 0x7F)]
     }
 
-    /// The register address the `n`-th data byte (`n ≥ 1`) of a burst from `start` reads.
+    /// The register the `n`-th register byte (`n ≥ 1`) of a burst from `start` reads (on a
+    /// chip with a dummy byte, the data byte after it is the first register byte).
     pub fn burst_address(&self, start: u8, n: usize) -> u8 {
         let mut addr = start & 0x7F;
         for _ in 1..n.min(STREAM_LEN) {
             addr = self.next_address(addr);
         }
         addr
+    }
+
+    /// The byte a read clocks out ahead of the addressed register's value, if the chip's reads
+    /// have one ([`Chip::spi_read_dummy`]).
+    pub fn dummy(&self) -> Option<u8> {
+        self.dummy
+    }
+
+    /// The MISO bytes of a read burst from `start`, after the address byte, one by one: the
+    /// dummy byte first on chips with one, then the registers in burst order.
+    pub fn burst_bytes(&self, start: u8) -> BurstBytes<'_> {
+        BurstBytes {
+            shadow: self,
+            addr: start & 0x7F,
+            dummy: self.dummy,
+        }
     }
 
     /// The predicted burst's start address.
@@ -233,7 +257,8 @@ impl Shadow {
         }
         if changed != [0; 4] {
             let mut addr = self.start;
-            for slot in &mut self.stream[1..] {
+            let data = 1 + usize::from(self.dummy.is_some());
+            for slot in self.stream.iter_mut().skip(data) {
                 let i = usize::from(addr);
                 if changed[i / 32] & (1 << (i % 32)) != 0 {
                     *slot = self.regs[i];
@@ -241,5 +266,25 @@ impl Shadow {
                 addr = self.next[i];
             }
         }
+    }
+}
+
+/// The MISO bytes of a read burst served from a [`Shadow`] ([`Shadow::burst_bytes`]).
+#[derive(Clone, Debug)]
+pub struct BurstBytes<'a> {
+    shadow: &'a Shadow,
+    addr: u8,
+    dummy: Option<u8>,
+}
+
+impl BurstBytes<'_> {
+    /// The next byte.
+    pub fn next_byte(&mut self) -> u8 {
+        if let Some(dummy) = self.dummy.take() {
+            return dummy;
+        }
+        let byte = self.shadow.read(self.addr);
+        self.addr = self.shadow.next_address(self.addr);
+        byte
     }
 }

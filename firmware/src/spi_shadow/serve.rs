@@ -141,21 +141,24 @@ pub fn serve(port: &mut impl SpiPort, shadow: &mut Shadow, capture: &mut Capture
 
 /// A read the stream does not serve: stop it and feed the TX register from the shadow.
 ///
-/// The first data byte is written before anything else is worked out (the fewer instructions
-/// between the address byte and this write, the slower a clock the takeover beats); then the
-/// stream's progress says which byte that write actually feeds, and a late write is corrected
-/// so that the rest of the burst is right.
+/// The first data byte (the dummy byte on chips with one) is written before anything else is
+/// worked out (the fewer instructions between the address byte and this write, the slower a
+/// clock the takeover beats); then the stream's progress says which byte that write actually
+/// feeds, and a late write is corrected so that the rest of the burst is right.
 fn take_over(port: &mut impl SpiPort, shadow: &Shadow, capture: &mut Capture, start: u8) {
     let waiting = port.stop_stream();
-    let mut byte = shadow.read(start);
+    let mut bytes = shadow.burst_bytes(start);
+    let mut byte = bytes.next_byte();
     port.write_tx(byte);
     let mut next = port
         .stream_taken()
         .saturating_sub(usize::from(waiting))
         .max(1);
-    let mut addr = shadow.burst_address(start, next);
     if next > 1 {
-        byte = shadow.read(addr);
+        for _ in 2..next {
+            bytes.next_byte();
+        }
+        byte = bytes.next_byte();
         port.write_tx(byte);
     }
     capture.takeover = Some(next);
@@ -163,8 +166,7 @@ fn take_over(port: &mut impl SpiPort, shadow: &Shadow, capture: &mut Capture, st
     while port.selected() {
         if port.tx_empty() {
             next += 1;
-            addr = shadow.next_address(addr);
-            let byte = shadow.read(addr);
+            let byte = bytes.next_byte();
             port.write_tx(byte);
             capture.set_sent(next, byte);
         }

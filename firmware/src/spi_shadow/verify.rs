@@ -34,11 +34,15 @@ pub enum Outcome {
     Truncated,
 }
 
-/// Replays `capture` into `chip` (select, every MOSI byte, deselect) and compares the MISO the
-/// chip gives with what the board sent. `generation` is the generation of the chip state now.
+/// Replays `capture` into `chip` (select, every MOSI byte, deselect; an empty capture is a
+/// bare chip-select toggle) and compares the MISO the chip gives with what the board sent. `generation` is the generation of the chip state now.
 pub fn replay(chip: &mut impl SpiTarget, capture: &Capture, generation: u32) -> Outcome {
     let (mosi, sent) = (capture.mosi(), capture.sent());
     let Some(&first) = mosi.first() else {
+        // Chip select fell and rose: the chip sees the edges (the BMI270 switches to SPI on
+        // the rising one, which Betaflight's bare chip-select toggle relies on).
+        chip.select();
+        chip.deselect();
         return Outcome::Empty;
     };
     let mut expected = chip.select();

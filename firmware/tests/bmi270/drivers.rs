@@ -1,26 +1,11 @@
 //! The register sequences of three drivers, as read in their sources (no code taken):
-//! ArduPilot `AP_InertialSensor_BMI270.cpp` (dummy read, CHIP_ID, soft reset, upload with
-//! INTERNAL_STATUS check and retries, configuration with read-back of every write, FIFO at
-//! 1.6 kHz), Betaflight `accgyro_spi_bmi270.c` (upload without a check, gyro 3.2 kHz / accel
-//! 800 Hz, one data read from 0x0C) and the `bmi2` crate (8 KB file in chunks through
-//! INIT_ADDR).
+//! ArduPilot `AP_InertialSensor_BMI270.cpp` and Betaflight `accgyro_spi_bmi270.c` through the
+//! shared sequences of `fc.rs` (every sample decoded in order), and the `bmi2` crate's 8 KB
+//! file in chunks through INIT_ADDR (the crate itself runs in `margemu-hil`'s
+//! `tests/driver_bmi2.rs`, over I2C); and a driver that reads the chip before its upload has
+//! completed.
 
 use super::*;
-use margemu_firmware::chip::PhysicalSample;
-
-const G: f32 = 9.80665;
-
-/// Writes `value` and reads it back, as ArduPilot's `write_register` does (up to 8 tries);
-/// whether it read back.
-fn write_verified(c: &mut Bmi270, addr: u8, value: u8) -> bool {
-    for _ in 0..8 {
-        spi_write(c, addr, &[value]);
-        if read1(c, addr) == value {
-            return true;
-        }
-    }
-    false
-}
 
 /// Dummy read, CHIP_ID check, soft reset, dummy read again.
 fn probe_and_reset(c: &mut Bmi270) {
@@ -32,112 +17,96 @@ fn probe_and_reset(c: &mut Bmi270) {
     assert_eq!(read1(c, 0x00), 0x24, "CHIP_ID after reset");
 }
 
-/// ArduPilot's `hardware_init`: dummy read, soft reset through the read-back write (CMD reads 0,
-/// so it is sent 8 times, each time resetting the chip), dummy read, CHIP_ID, PWR_CONF 0,
-/// upload, INIT_CTRL 1, init_ok after 20 ms; up to 5 tries.
-fn ardupilot_init(c: &mut Bmi270, file: &[u8]) -> bool {
-    for _ in 0..5 {
-        dummy_read(c);
-        c.advance(c.now_ns() + MS);
-        assert!(!write_verified(c, 0x7E, 0xB6), "CMD never reads back");
-        c.advance(c.now_ns() + 5 * MS);
-        dummy_read(c);
-        c.advance(c.now_ns() + MS);
-        if read1(c, 0x00) != 0x24 {
-            continue;
-        }
-        upload(c, file);
-        c.advance(c.now_ns() + 20 * MS);
-        if read1(c, 0x21) & 1 == 1 {
-            return true;
-        }
-    }
-    false
-}
-
-fn twelve_bytes(c: &mut Bmi270) -> Vec<i16> {
-    read(c, 0x0C, 12)
-        .chunks(2)
-        .map(|w| i16::from_le_bytes([w[0], w[1]]))
-        .collect()
-}
-
 #[test]
-fn ardupilot_sequence() {
+fn ardupilot_reads_every_sample_in_order_from_the_fifo_at_1600_hz() {
     let mut c = chip();
-    assert!(ardupilot_init(&mut c, &config_file(328)));
-    for (addr, value) in [
-        (0x40, 0x8C), // ACC_CONF: 1.6 kHz, performance, OSR4
-        (0x41, 0x03), // ACC_RANGE: ±16 g
-        (0x42, 0xED), // GYR_CONF: 3.2 kHz, noise and filter performance, normal
-        (0x43, 0x08), // GYR_RANGE: ±2000 °/s with the OIS range bit
-        (0x48, 0x01), // FIFO_CONFIG_0: stop on full, no sensor time frame
-        (0x49, 0xD0), // FIFO_CONFIG_1: gyro, accel, headers
-        (0x45, 0x89), // FIFO_DOWNS: filtered data, gyro downsampled by 2
-        (0x7C, 0x02), // PWR_CONF: fifo_self_wakeup, no advanced power save
-        (0x7D, 0x0E), // PWR_CTRL: accel, gyro, temperature
-    ] {
-        assert!(write_verified(&mut c, addr, value), "{addr:#04x}");
-    }
-    assert_eq!(c.sample_period_ns(), Some(312_500));
-    let s = PhysicalSample {
-        acc: [0.0, 0.0, -G],
-        gyr: [0.1, -0.2, 0.3],
-        temp_c: 40.0,
-        ..Default::default()
-    };
-    c.latch_at(&s, c.now_ns() + 312_500);
-    let data = twelve_bytes(&mut c);
-    assert_eq!(data[..3], [0, 0, -2048]);
-    for (raw, w) in data[3..].iter().zip(s.gyr) {
-        let want = f64::from(w).to_degrees() * 16.4;
-        assert!((f64::from(*raw) - want).abs() <= 1.0, "{raw} vs {want}");
-    }
-    let t = read(&mut c, 0x22, 2);
-    assert_ne!(t, [0x00, 0x80], "temperature valid");
-    assert_eq!(i16::from_le_bytes([t[0], t[1]]), 17 * 512);
+    let run = fc::ardupilot(&mut c, 400);
+    assert_eq!(run.init_tries, 1);
+    assert_eq!(run.samples.len(), 400, "one 0x8C frame per 625 µs poll");
+    assert_eq!(run.samples, run.expected);
+    assert_eq!((run.fifo_resets, run.single_frames), (0, 0));
+    // Every 100 polls the temperature, updated every 10 ms (32 latches at 3.2 kHz): the
+    // sample of the last 10 ms boundary, 23 °C + n/512 K reading n.
+    assert_eq!(run.temperatures, [192, 384, 576, 768]);
+    assert_eq!(c.sample_period_ns(), Some(fc::GYRO_3K2_NS));
 }
 
 #[test]
 fn ardupilot_gives_up_on_a_truncated_file() {
     let mut c = chip();
-    assert!(!ardupilot_init(&mut c, &config_file(200)));
+    assert_eq!(fc::ardupilot_init(&mut c, 200), (false, 5));
     assert_eq!(read1(&mut c, 0x21), 0x02);
 }
 
 #[test]
-fn betaflight_sequence() {
+fn betaflight_reads_every_sample_on_its_data_ready_edge() {
+    let mut c = chip();
+    let run = fc::betaflight(&mut c, 400);
+    assert_eq!(run.samples.len(), 400, "one rising edge per 3.2 kHz sample");
+    assert_eq!(
+        run.samples, run.expected,
+        "accel new every fourth sample (800 Hz)"
+    );
+    assert_eq!(read1(&mut c, 0x21), 0x01); // init_ok, though Betaflight never looks
+}
+
+/// Before the configuration upload has completed the chip answers, but its sensors do not run
+/// (see the chip module's docs): a driver that skips or botches the upload reads zeros, the
+/// invalid temperature, an empty FIFO and never gets a data-ready, and nothing panics.
+#[test]
+fn a_driver_reading_before_the_upload_completes() {
     let mut c = chip();
     probe_and_reset(&mut c);
-    upload(&mut c, &config_file(328));
-    c.advance(c.now_ns() + 20 * MS); // Betaflight never checks INTERNAL_STATUS
-    for (addr, value) in [
-        (0x40, 0xAB), // ACC_CONF: 800 Hz
-        (0x41, 0x03), // ACC_RANGE: ±16 g
-        (0x42, 0xED), // GYR_CONF: 3.2 kHz
-        (0x43, 0x08), // GYR_RANGE: ±2000 °/s, OIS ±2000
-        (0x58, 0x04), // INT_MAP_DATA: data ready on INT1
-        (0x53, 0x0A), // INT1_IO_CTRL: output, active high, push-pull
-        (0x7C, 0x02), // PWR_CONF
-        (0x7D, 0x0E), // PWR_CTRL
-    ] {
-        spi_write(&mut c, addr, &[value]);
-    }
-    assert_eq!(read1(&mut c, 0x21), 0x01); // init_ok all the same
-    assert_eq!(c.sample_period_ns(), Some(312_500));
-    let s = PhysicalSample {
-        acc: [G, 2.0 * G, -4.0 * G],
-        gyr: [1.0, -1.0, 0.0],
-        temp_c: 23.0,
-        ..Default::default()
+    assert_eq!(read1(&mut c, 0x21), 0x00, "INTERNAL_STATUS not_init");
+    let configure = |c: &mut Bmi270| {
+        spi_write(c, 0x40, &[0xAC, 0x03, 0xAC, 0x08]); // 1.6 kHz, ±16 g, ±2000 °/s
+        spi_write(c, 0x48, &[0x01, 0xD0]); // FIFO with headers
+        spi_write(c, 0x58, &[0x04]); // data ready on INT1
+        spi_write(c, 0x53, &[0x0A]); // push-pull, active high
+        spi_write(c, 0x7D, &[0x0E]); // accel, gyro, temperature
     };
-    c.latch_at(&s, c.now_ns() + 312_500);
-    let data = twelve_bytes(&mut c);
-    assert_eq!(data[..3], [2048, 4096, -8192]);
-    let one_radps = 1.0f64.to_degrees() * 16.4; // 939.6
-    assert!((f64::from(data[3]) - one_radps).abs() <= 1.0);
-    assert!((f64::from(data[4]) + one_radps).abs() <= 1.0);
-    assert_eq!(data[5], 0);
+    configure(&mut c);
+    let nothing = |c: &mut Bmi270, when: &str| {
+        for k in 1..=8i16 {
+            let t = c.now_ns() + 625_000;
+            c.latch_at(&fc::sample(k), t);
+            assert!(!c.int_pin_at(t), "{when}: no data-ready pulse");
+        }
+        assert_eq!(
+            read(c, 0x0C, 12),
+            [0; 12],
+            "{when}: data registers at reset"
+        );
+        assert_eq!(
+            read(c, 0x22, 2),
+            [0x00, 0x80],
+            "{when}: temperature invalid"
+        );
+        assert_eq!(read1(c, 0x03), 0x10, "{when}: STATUS cmd_rdy, no drdy");
+        assert_eq!(read1(c, 0x1D), 0x00, "{when}: INT_STATUS_1");
+        assert_eq!(read(c, 0x24, 2), [0, 0], "{when}: FIFO empty");
+        assert_eq!(read(c, 0x26, 3), [0x80; 3], "{when}: FIFO_DATA over-read");
+        assert_ne!(read(c, 0x18, 3), [0; 3], "{when}: SENSORTIME runs");
+    };
+    nothing(&mut c, "no upload");
+    // Half the file, INIT_CTRL still 0: the load is under way.
+    spi_write(&mut c, 0x59, &[0x00]);
+    spi_write(&mut c, 0x5E, &config_file(164));
+    assert_eq!(read1(&mut c, 0x21), 0x00);
+    nothing(&mut c, "during the upload");
+    // The load ends short: init_err, still nothing.
+    spi_write(&mut c, 0x59, &[0x01]);
+    assert_eq!(read1(&mut c, 0x21), 0x02);
+    nothing(&mut c, "after init_err");
+    // A whole file: the same configuration now gives data.
+    upload(&mut c, &config_file(328));
+    assert_eq!(read1(&mut c, 0x21), 0x01);
+    let t = c.now_ns() + 625_000;
+    c.latch_at(&fc::sample(5), t);
+    assert!(c.int_pin_at(t));
+    let data = read(&mut c, 0x0C, 12);
+    assert_eq!(i16::from_le_bytes([data[0], data[1]]), 5);
+    assert_eq!(read(&mut c, 0x24, 2), [13, 0]);
 }
 
 #[test]

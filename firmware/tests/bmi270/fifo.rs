@@ -5,10 +5,11 @@ use margemu_firmware::chip::PhysicalSample;
 
 const G: f32 = 9.80665;
 
-/// PWR_CTRL accel + gyro + temperature, ±16 g, ±2000 °/s, FIFO_CONFIG_0/1 as given.
+/// Configuration uploaded, accel and gyro at 1.6 kHz (the latches here are 625 µs apart), PWR_CTRL
+/// accel + gyro + temperature, ±16 g, ±2000 °/s, FIFO_CONFIG_0/1 as given.
 fn fifo_chip(config0: u8, config1: u8) -> Bmi270 {
-    let mut c = spi_chip();
-    spi_write(&mut c, 0x41, &[0x03]);
+    let mut c = ready_chip();
+    spi_write(&mut c, 0x40, &[0xAC, 0x03, 0xAC]);
     spi_write(&mut c, 0x43, &[0x08]);
     spi_write(&mut c, 0x48, &[config0, config1]);
     spi_write(&mut c, 0x7D, &[0x0E]);
@@ -117,7 +118,7 @@ fn stream_mode_overflow_sets_fifo_err_until_a_flush() {
 }
 
 #[test]
-fn ardupilot_reads_the_fifo_at_1600_hz() {
+fn two_frames_per_poll_at_1600_hz() {
     let mut c = fifo_chip(0x01, 0xD0);
     spi_write(&mut c, 0x7E, &[0xB0]);
     for round in 0..4i16 {

@@ -8,10 +8,15 @@
 
 #![allow(missing_docs)]
 
+mod boundary;
 mod bus;
 mod data;
 mod drivers;
+mod fc;
 mod fifo;
+mod i2c;
+mod interrupts;
+mod rates;
 mod upload;
 
 #[path = "../common/transactions.rs"]
@@ -33,6 +38,15 @@ pub fn chip() -> Bmi270 {
 pub fn spi_chip() -> Bmi270 {
     let mut c = chip();
     dummy_read(&mut c);
+    c
+}
+
+/// A chip in SPI mode with the 328-byte configuration file uploaded: INTERNAL_STATUS init_ok,
+/// the sensors run once PWR_CTRL enables them.
+pub fn ready_chip() -> Bmi270 {
+    let mut c = spi_chip();
+    upload(&mut c, &config_file(328));
+    assert_eq!(read1(&mut c, 0x21), 0x01, "init_ok");
     c
 }
 

@@ -29,6 +29,7 @@ impl BenchChip for &mut Shadowed {
         match self.chip() {
             EmulatedChip::Mpu6xxx(chip) => chip.is_running(),
             EmulatedChip::Icm42688p(chip) => chip.is_running(),
+            EmulatedChip::Bmi270(chip) => chip.sample_period_ns().is_some(),
             other => panic!("a 6xxx or ICM sequence on a {:?}", other.model()),
         }
     }

@@ -16,11 +16,13 @@
 //! initialisation, as `fc_mpu.rs` does); one written for a chip's own test crate runs from its
 //! file, included with `#[path]`, over that crate's rig trait implemented for [`Shadowed`]:
 //! `icm42688p.rs` (the ICM-42688-P sequences of `tests/icm42688p/fc_*.rs` and their `Rig`) and
-//! `fc_6xxx.rs` (the MPU-6000 and ICM-20602 sequences of `tests/common/fc.rs` on its `Bench`).
+//! `fc_6xxx.rs` (the MPU-6000 and ICM-20602 sequences of `tests/common/fc.rs` on its `Bench`)
+//! and `bmi270.rs` (the BMI270 sequences of `tests/bmi270/fc.rs`, reads behind a dummy byte).
 //! Those mark the loop's start (`loop_starts`) and run the loop at the sample clock, as the
 //! drivers switch to it there (ArduPilot's register checks on the ICM-42688-P go back to the
 //! low clock for the read, as the driver does: `set_fast`).
 
+mod bmi270;
 #[path = "../common/mod.rs"]
 mod common;
 mod fc_6xxx;
@@ -255,6 +257,8 @@ pub const SEQUENCES: &[(&str, NewChip, Sequence)] = &[
         icm42688p::ardupilot_8khz,
     ),
     ("px4-icm42688p", icm42688p, icm42688p::px4),
+    ("betaflight-bmi270", bmi270, bmi270::betaflight),
+    ("ardupilot-bmi270", bmi270, bmi270::ardupilot),
 ];
 
 fn mpu9250() -> EmulatedChip {
@@ -271,6 +275,11 @@ fn icm20602() -> EmulatedChip {
 
 fn icm42688p() -> EmulatedChip {
     EmulatedChip::new(ChipModel::Icm42688p, 0x47, 0x68).expect("an emulated model")
+}
+
+/// A BMI270 just powered on, at 0x68.
+pub fn bmi270() -> EmulatedChip {
+    EmulatedChip::new(ChipModel::Bmi270, 0x24, 0x68).expect("an emulated model")
 }
 
 /// Samples each sequence runs over.

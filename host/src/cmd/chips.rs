@@ -44,7 +44,8 @@ pub fn describe(model: ChipModel) -> String {
         model.part_name(),
         model.name()
     );
-    out += &format!("  WHO_AM_I:     {}\n", hexes(model.identities()));
+    let id = format!("{}:", model.identity_register());
+    out += &format!("  {id:<14}{}\n", hexes(model.identities()));
     let spi = model.buses().contains(margemu_protocol::link::Buses::SPI);
     out += &format!(
         "  buses:        {}I2C at {}\n",
@@ -96,10 +97,14 @@ pub fn describe(model: ChipModel) -> String {
 
 /// The output rates of `model` in words.
 fn rates(model: ChipModel) -> String {
-    let candidates = [
-        32_000.0, 16_000.0, 8_000.0, 4_000.0, 2_000.0, 1_000.0, 500.0, 200.0, 100.0, 50.0, 25.0,
-        12.5,
-    ];
+    let candidates: &[f64] = match model {
+        // The gyro ODRs, 100 Hz · 2^n.
+        ChipModel::Bmi270 => &[3_200.0, 1_600.0, 800.0, 400.0, 200.0, 100.0, 50.0, 25.0],
+        _ => &[
+            32_000.0, 16_000.0, 8_000.0, 4_000.0, 2_000.0, 1_000.0, 500.0, 200.0, 100.0, 50.0,
+            25.0, 12.5,
+        ],
+    };
     let listed = list(
         candidates
             .iter()
@@ -109,6 +114,9 @@ fn rates(model: ChipModel) -> String {
     match model {
         ChipModel::Mpu6000 => format!("{listed}, … (8 kHz or 1 kHz / (1 + SMPLRT_DIV))"),
         ChipModel::Icm42688p => listed,
+        ChipModel::Bmi270 => {
+            format!("{listed} (the gyro's ODR; the accelerometer at its own, at most 1.6 kHz)")
+        }
         _ => format!("{listed}, … (32 kHz, 8 kHz, or 1 kHz / (1 + SMPLRT_DIV))"),
     }
 }

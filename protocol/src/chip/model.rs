@@ -17,6 +17,8 @@ pub enum Family {
     Qmc5883l,
     /// PNI RM3100 magnetometer ([`crate::regmap::rm3100`]).
     Rm3100,
+    /// Bosch BMI270 ([`crate::regmap::bmi270`]).
+    Bmi270,
 }
 
 /// An emulated chip model. Its wire code ([`ChipModel::code`]) is the bit of
@@ -35,6 +37,8 @@ pub enum ChipModel {
     Icm20602 = 3,
     /// TDK InvenSense ICM-42688-P, WHO_AM_I 0x47.
     Icm42688p = 4,
+    /// Bosch BMI270, CHIP_ID 0x24.
+    Bmi270 = 5,
     /// iSentek IST8310 magnetometer (I2C only), WAI 0x10.
     Ist8310 = 6,
     /// QST QMC5883L magnetometer (I2C only), chip id 0xFF.
@@ -45,12 +49,13 @@ pub enum ChipModel {
 
 impl ChipModel {
     /// Every model, in code order.
-    pub const ALL: [Self; 8] = [
+    pub const ALL: [Self; 9] = [
         Self::Mpu9250,
         Self::Mpu6500,
         Self::Mpu6000,
         Self::Icm20602,
         Self::Icm42688p,
+        Self::Bmi270,
         Self::Ist8310,
         Self::Qmc5883l,
         Self::Rm3100,
@@ -77,6 +82,7 @@ impl ChipModel {
             Self::Ist8310 => "ist8310",
             Self::Qmc5883l => "qmc5883l",
             Self::Rm3100 => "rm3100",
+            Self::Bmi270 => "bmi270",
         }
     }
 
@@ -91,6 +97,7 @@ impl ChipModel {
             Self::Ist8310 => "IST8310",
             Self::Qmc5883l => "QMC5883L",
             Self::Rm3100 => "RM3100",
+            Self::Bmi270 => "BMI270",
         }
     }
 
@@ -113,6 +120,7 @@ impl ChipModel {
             Self::Ist8310 => Family::Ist8310,
             Self::Qmc5883l => Family::Qmc5883l,
             Self::Rm3100 => Family::Rm3100,
+            Self::Bmi270 => Family::Bmi270,
             _ => Family::Mpu6xxx,
         }
     }
@@ -125,9 +133,21 @@ impl ChipModel {
 
     /// The WHO_AM_I value of the part itself (the first of [`ChipModel::identities`]; for the
     /// magnetometers, the identity register drivers check: the IST8310's WAI, the
-    /// QMC5883L's chip id register 0x0D, the RM3100's REVID).
+    /// QMC5883L's chip id register 0x0D, the RM3100's REVID; the BMI270's CHIP_ID).
     pub const fn who_am_i(self) -> u8 {
         self.identities()[0]
+    }
+
+    /// The name of the identity register the datasheet gives ([`ChipModel::identities`] are
+    /// its values): `"WHO_AM_I"`, the BMI270's `"CHIP_ID"`.
+    pub const fn identity_register(self) -> &'static str {
+        match self {
+            Self::Bmi270 => "CHIP_ID",
+            Self::Ist8310 => "WAI",
+            Self::Qmc5883l => "CHIP_ID 0x0D",
+            Self::Rm3100 => "REVID",
+            _ => "WHO_AM_I",
+        }
     }
 
     /// Every WHO_AM_I value the model can be told to answer (identity variants of one register
@@ -142,6 +162,7 @@ impl ChipModel {
             Self::Ist8310 => &[crate::regmap::ist8310::WAI_VALUE],
             Self::Qmc5883l => &[crate::regmap::qmc5883l::CHIP_ID_VALUE],
             Self::Rm3100 => &[crate::regmap::rm3100::REVID_VALUE],
+            Self::Bmi270 => &[crate::regmap::bmi270::CHIP_ID],
         }
     }
 
@@ -155,10 +176,11 @@ impl ChipModel {
     }
 
     /// The 7-bit I2C addresses the part can be strapped to (the default first: AD0 low for the
-    /// IMUs; the IST8310's CAD pins give 0x0C–0x0F, 0x0E with both low; the QMC5883L has one;
-    /// the RM3100's SA0/SA1 pins give 0x20–0x23).
+    /// InvenSense IMUs, SDO low for the BMI270; the IST8310's CAD pins give 0x0C–0x0F, 0x0E with
+    /// both low; the QMC5883L has one; the RM3100's SA0/SA1 pins give 0x20–0x23).
     pub const fn i2c_addresses(self) -> &'static [u8] {
         match self {
+            Self::Bmi270 => &crate::regmap::bmi270::I2C_ADDRESSES,
             Self::Ist8310 => &crate::regmap::ist8310::I2C_ADDRESSES,
             Self::Qmc5883l => &[crate::regmap::qmc5883l::I2C_ADDRESS],
             Self::Rm3100 => &[0x20, 0x21, 0x22, 0x23],
@@ -168,7 +190,7 @@ impl ChipModel {
 
     /// Register files of the model, as [`RegisterOverride::file`](crate::link::RegisterOverride)
     /// numbers them: the MPU-9250's die (0) and its AK8963 (1); the ICM-42688-P's banks 0–4;
-    /// one file otherwise.
+    /// one file otherwise (the BMI270's one page of 128 registers).
     pub const fn register_files(self) -> u8 {
         match self {
             Self::Mpu9250 => 2,
@@ -206,6 +228,16 @@ impl ChipModel {
                 "FIFO: 8-, 16- and 20-byte packets with headers, 20-bit data, timestamps,                  count in bytes or records, lost packets, overflow, watermark",
                 "INT1/INT2: data ready, FIFO threshold and full, reset done; pulse or latched",
             ],
+            Family::Bmi270 => &[
+                "every register with its reset value, write mask and read-back (one page)",
+                "SPI with its dummy byte and the switch from I2C on a chip-select rising edge; I2C",
+                "configuration upload (328-byte and 8 KB files, INIT_ADDR chunks), INTERNAL_STATUS; \
+                 no data before init_ok",
+                "16-bit little-endian data at the configured ranges; accel at its own ODR; \
+                 temperature every 10 ms; SENSORTIME",
+                "FIFO: headered and headerless frames, FIFO_DOWNS, stop-on-full or fifo_err, flush",
+                "INT1/INT2: data ready, pulsed (156.25 µs) or latched, level, open drain, output enable",
+            ],
             Family::Ist8310 => &[
                 "I2C target at its four strap addresses, registers with reset values and masks",
                 "single measurements (CNTL1 = 1) taking the time the averaging (AVGCNTL) needs",
@@ -241,6 +273,12 @@ impl ChipModel {
             }
             Family::Qmc5883l => &["temperature output, over-sampling noise, the DRDY pin"],
             Family::Rm3100 => &["the DRDY pin, noise, the output's bend beyond +-800 uT"],
+            Family::Bmi270 => &[
+                "the filters' effect on the data, pre-filtered FIFO data (settings are stored)",
+                "the configuration file's features (FEATURES pages are storage), the time init takes",
+                "FIFO sensor time, skip and configuration frames, watermark and full interrupts",
+                "low-power timing (adv_power_save is stored), the auxiliary interface, self-test, offsets",
+            ],
         }
     }
 
@@ -255,6 +293,7 @@ impl ChipModel {
             Self::Ist8310 => crate::regmap::ist8310::IMAGE_LEN,
             Self::Qmc5883l => crate::regmap::qmc5883l::IMAGE_LEN,
             Self::Rm3100 => crate::regmap::rm3100::IMAGE_LEN,
+            Self::Bmi270 => crate::regmap::bmi270::image::IMAGE_LEN,
         }
     }
 
@@ -263,6 +302,8 @@ impl ChipModel {
     /// divided by 1 + SMPLRT_DIV (RM-MPU-6000A section 4.2). MPU-6500, MPU-9250, ICM-20602:
     /// 32 kHz (FCHOICE_B), 8 kHz (DLPF_CFG 0 or 7), or 1 kHz / (1 + SMPLRT_DIV) (the divider
     /// applies only with the DLPF on; RM-MPU-9250A section 4.4). ICM-42688-P: its ODR codes.
+    /// BMI270: its gyro ODR codes, 25 Hz to 3.2 kHz (the served rate is the gyro's; the
+    /// accelerometer runs at its own ODR, at most 1.6 kHz).
     pub fn has_output_rate(self, rate_hz: f64) -> bool {
         let close = |r: f64| (r - rate_hz).abs() <= 1e-9 * r;
         let divided = |base: f64| (1..=256u32).any(|n| close(base / f64::from(n)));
@@ -274,6 +315,7 @@ impl ChipModel {
             Self::Icm42688p => crate::regmap::icm42688p::Odr::gyro_of_hz(rate_hz).is_some(),
             // A magnetometer measures on its own schedule; any rate of the rig's IMU serves it.
             Self::Ist8310 | Self::Qmc5883l | Self::Rm3100 => rate_hz > 0.0,
+            Self::Bmi270 => crate::regmap::bmi270::Odr::gyro_of_hz(rate_hz).is_some(),
         }
     }
 }
@@ -294,7 +336,8 @@ mod tests {
             Some(ChipModel::Icm42688p)
         );
         assert_eq!(ChipModel::from_name("MPU_6000"), Some(ChipModel::Mpu6000));
-        assert_eq!(ChipModel::from_name("bmi270"), None);
+        assert_eq!(ChipModel::from_name("BMI-270"), Some(ChipModel::Bmi270));
+        assert_eq!(ChipModel::from_name("bmi999"), None);
         assert_eq!(ChipModel::from_name("an-overlong-name-of-no-chip"), None);
         assert_eq!(ChipModel::from_code(200), None);
     }
@@ -307,5 +350,19 @@ mod tests {
         assert!(ChipModel::Icm42688p.has_output_rate(8000.0));
         assert!(ChipModel::Icm42688p.has_output_rate(12.5));
         assert!(!ChipModel::Icm42688p.has_output_rate(300.0));
+        assert!(ChipModel::Bmi270.has_output_rate(3200.0));
+        assert!(ChipModel::Bmi270.has_output_rate(25.0));
+        assert!(!ChipModel::Bmi270.has_output_rate(1000.0));
+        assert!(!ChipModel::Bmi270.has_output_rate(12.5));
+    }
+
+    #[test]
+    fn the_bmi270() {
+        let m = ChipModel::Bmi270;
+        assert_eq!((m.code(), m.who_am_i(), m.image_len()), (5, 0x24, 14));
+        assert_eq!((m.family(), m.register_files()), (Family::Bmi270, 1));
+        assert_eq!(m.identity_register(), "CHIP_ID");
+        assert_eq!(m.i2c_addresses(), &[0x68, 0x69]);
+        assert!(!m.has_magnetometer());
     }
 }

@@ -2,6 +2,8 @@
 //! physical sample ↔ register image, dispatched to the chip's module.
 
 use super::{ChipModel, Family, Image, PhysicalSample};
+use crate::regmap::bmi270::image::{ImageConfig as BmiConfig, ImageRepr as BmiRepr};
+use crate::regmap::bmi270::{self as bmi, convert as bmi_convert};
 use crate::regmap::icm42688p::image::{ImageConfig as IcmConfig, ImageRepr as IcmRepr};
 use crate::regmap::icm42688p::{self as icm, convert as icm_convert};
 use crate::regmap::mpu6xxx::image::{ImageConfig as Mpu6xxxConfig, ImageRepr as Mpu6xxxRepr};
@@ -21,6 +23,8 @@ pub enum Conversion {
     Qmc5883l(qmc5883l::Range),
     /// RM3100 at cycle counts x, y, z (its gain).
     Rm3100([u16; 3]),
+    /// BMI270 (ranges).
+    Bmi270(BmiConfig),
 }
 
 /// A full-scale choice: accelerometer range in g, gyroscope range in °/s.
@@ -85,6 +89,7 @@ impl ChipSettings {
             Family::Ist8310 => Conversion::Ist8310,
             Family::Qmc5883l => Conversion::Qmc5883l(qmc5883l::Range::default()),
             Family::Rm3100 => Conversion::Rm3100([rm3100::reset::CYCLE_COUNT; 3]),
+            Family::Bmi270 => Conversion::Bmi270(BmiConfig::NOMINAL),
         };
         Self { model, conversion }
     }
@@ -134,6 +139,16 @@ impl ChipSettings {
                     .find(|g| g.range_dps() == fs.gyro_dps)
                     .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
             }
+            Conversion::Bmi270(cfg) => {
+                cfg.acc_range = bmi::AccRange::ALL
+                    .into_iter()
+                    .find(|a| a.range_g() == fs.accel_g)
+                    .ok_or(SettingsError::AccelRange(fs.accel_g))?;
+                cfg.gyr_range = bmi::GyrRange::ALL
+                    .into_iter()
+                    .find(|g| g.range_dps() == fs.gyro_dps)
+                    .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
+            }
             Conversion::Ist8310 | Conversion::Qmc5883l(_) | Conversion::Rm3100(_) => {
                 return Err(SettingsError::AccelRange(fs.accel_g))
             }
@@ -150,6 +165,7 @@ impl ChipSettings {
                 .collect(),
             Family::Icm42688p => icm::AccelFs::ALL.iter().map(|a| a.range_g()).collect(),
             Family::Ist8310 | Family::Qmc5883l | Family::Rm3100 => heapless::Vec::new(),
+            Family::Bmi270 => bmi::AccRange::ALL.iter().map(|a| a.range_g()).collect(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -164,6 +180,7 @@ impl ChipSettings {
                 .collect(),
             Family::Icm42688p => icm::GyroFs::ALL.iter().map(|g| g.range_dps()).collect(),
             Family::Ist8310 | Family::Qmc5883l | Family::Rm3100 => heapless::Vec::new(),
+            Family::Bmi270 => bmi::GyrRange::ALL.iter().map(|g| g.range_dps()).collect(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -179,6 +196,10 @@ impl ChipSettings {
             Conversion::Icm42688p(cfg) => Some(FullScale {
                 accel_g: cfg.accel_fs.range_g(),
                 gyro_dps: cfg.gyro_fs.range_dps(),
+            }),
+            Conversion::Bmi270(cfg) => Some(FullScale {
+                accel_g: cfg.acc_range.range_g(),
+                gyro_dps: cfg.gyr_range.range_dps(),
             }),
             Conversion::Ist8310 | Conversion::Qmc5883l(_) | Conversion::Rm3100(_) => None,
         }
@@ -197,29 +218,30 @@ impl ChipSettings {
     /// The register writes, as `(register file, register, value)`, that take a power-on chip to
     /// these full scales and, where one register holds both, to the output rate `rate_hz` (the
     /// ICM-42688-P's GYRO_CONFIG0/ACCEL_CONFIG0; the 6xxx parts keep their power-on rate
-    /// registers; the QMC5883L's range in CONF1, in stand-by: its driver starts it). Writes
+    /// registers; the QMC5883L's range in CONF1, in stand-by: its driver starts it). The BMI270 gets its ranges and, in GYR_CONF and ACC_CONF (their other bits
+    /// at the power-on values), the gyro ODR of `rate_hz` and the accel ODR nearest below or at
+    /// it (1.6 kHz for a 3.2 kHz gyro: the chip then takes every second image's accel). Writes
     /// that would store the power-on value are left out.
     pub fn config_writes(&self, rate_hz: f64) -> impl Iterator<Item = (u8, u8, u8)> {
-        let writes: heapless::Vec<(u8, u8, u8), 2> = match &self.conversion {
-            Conversion::Mpu6xxx(cfg) => heapless::Vec::from_iter([
+        let writes: Writes = match &self.conversion {
+            Conversion::Mpu6xxx(cfg) => writes(&[
                 (0, mpu::reg::GYRO_CONFIG, cfg.gyro_fs.bits() << 3),
                 (0, mpu::reg::ACCEL_CONFIG, cfg.accel_fs.bits() << 3),
             ]),
             // The RM3100's cycle counts are its driver's to set (200, their reset value, in
             // ArduPilot and PX4).
-            Conversion::Ist8310 | Conversion::Rm3100(_) => heapless::Vec::new(),
-            Conversion::Qmc5883l(range) => {
-                heapless::Vec::from_iter([(0, qmc5883l::reg::CONF1, range.conf1_bits())])
-            }
+            Conversion::Ist8310 | Conversion::Rm3100(_) => writes(&[]),
+            Conversion::Qmc5883l(range) => writes(&[(0, qmc5883l::reg::CONF1, range.conf1_bits())]),
             Conversion::Icm42688p(cfg) => {
                 let reset = |reg| icm::reset_value(0, reg);
                 let odr = icm::Odr::gyro_of_hz(rate_hz)
                     .map_or(reset(icm::bank0::GYRO_CONFIG0) & 0x0F, icm::Odr::bits);
-                heapless::Vec::from_iter([
+                writes(&[
                     (0, icm::bank0::GYRO_CONFIG0, cfg.gyro_fs.bits() << 5 | odr),
                     (0, icm::bank0::ACCEL_CONFIG0, cfg.accel_fs.bits() << 5 | odr),
                 ])
             }
+            Conversion::Bmi270(cfg) => bmi270_writes(cfg, rate_hz),
         };
         let model = self.model;
         writes
@@ -259,12 +281,17 @@ impl ChipSettings {
                 &mut image,
                 &rm3100::image(rm3100::measurement(sample.mag, *cycle_counts)),
             ),
+            Conversion::Bmi270(cfg) => copy(
+                &mut image,
+                &BmiRepr::from_physical(acc, gyr, temp, cfg).emit(),
+            ),
         }
         image
     }
 
     /// The physical values an image of this model stands for under these settings; `None` if
-    /// the image is not of the model's length.
+    /// the image is not of the model's length. A BMI270 temperature of 0x8000 (invalid) reads
+    /// as NaN.
     pub fn decode(&self, image: &[u8]) -> Option<Reading> {
         if image.len() != self.model.image_len() {
             return None;
@@ -290,6 +317,20 @@ impl ChipSettings {
                         .gyro
                         .map(|v| f64::from(icm_convert::gyro_from_raw(v, cfg.gyro_fs))),
                     temp_c: f64::from(icm_convert::temp_from_raw(r.temp)),
+                    mag_ut: None,
+                }
+            }
+            Conversion::Bmi270(cfg) => {
+                let bytes: &[u8; bmi::image::IMAGE_LEN] = image.try_into().ok()?;
+                let r = BmiRepr::parse(bytes);
+                Reading {
+                    acc: r
+                        .accel
+                        .map(|v| f64::from(bmi_convert::accel_from_raw(v, cfg.acc_range))),
+                    gyr: r
+                        .gyro
+                        .map(|v| f64::from(bmi_convert::gyro_from_raw(v, cfg.gyr_range))),
+                    temp_c: bmi_convert::temp_from_raw(r.temp).map_or(f64::NAN, f64::from),
                     mag_ut: None,
                 }
             }
@@ -319,6 +360,109 @@ fn power_on_value(model: ChipModel, file: u8, reg: u8) -> u8 {
     match (model.family(), file) {
         (Family::Mpu6xxx, 0) => mpu::reset_value(reg),
         (Family::Icm42688p, bank) => icm::reset_value(bank, reg),
+        (Family::Bmi270, 0) => bmi::reset_value(reg),
         _ => 0,
+    }
+}
+
+/// The configuration writes of one model, `(file, register, value)`.
+type Writes = heapless::Vec<(u8, u8, u8), 4>;
+
+/// `list` as [`Writes`] (every list here has at most 4 writes).
+fn writes(list: &[(u8, u8, u8)]) -> Writes {
+    Writes::from_slice(list).unwrap_or_default()
+}
+
+/// The BMI270's writes (see [`ChipSettings::config_writes`]).
+fn bmi270_writes(cfg: &BmiConfig, rate_hz: f64) -> Writes {
+    let conf = |reg: u8, odr: Option<bmi::Odr>| {
+        let reset = bmi::reset_value(reg);
+        (0, reg, odr.map_or(reset, |o| (reset & 0xF0) | o.code()))
+    };
+    let accel_hz = if rate_hz > bmi::Odr::HZ1600.hz() {
+        bmi::Odr::HZ1600.hz()
+    } else {
+        rate_hz
+    };
+    writes(&[
+        (0, bmi::reg::ACC_RANGE, cfg.acc_range.bits()),
+        (0, bmi::reg::GYR_RANGE, cfg.gyr_range.bits()),
+        conf(bmi::reg::GYR_CONF, bmi::Odr::gyro_of_hz(rate_hz)),
+        conf(bmi::reg::ACC_CONF, bmi::Odr::accel_of_hz(accel_hz)),
+    ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bmi(accel_g: f64, gyro_dps: f64) -> ChipSettings {
+        let fs = FullScale { accel_g, gyro_dps };
+        ChipSettings::with_full_scale(ChipModel::Bmi270, fs).unwrap()
+    }
+
+    #[test]
+    fn bmi270_config_writes_set_ranges_and_both_rates() {
+        let writes: Writes = bmi(16.0, 500.0).config_writes(3200.0).collect();
+        // ACC_RANGE ±16 g, GYR_RANGE ±500 °/s, GYR_CONF 3.2 kHz, ACC_CONF 1.6 kHz; the other
+        // bits of the CONF registers keep their power-on values (0xA9, 0xA8).
+        assert_eq!(
+            writes,
+            [
+                (0, 0x41, 0x03),
+                (0, 0x43, 0x02),
+                (0, 0x42, 0xAD),
+                (0, 0x40, 0xAC)
+            ]
+        );
+        // At the power-on ranges and the power-on rates (gyro 200 Hz, accel 100 Hz) only the
+        // accel ODR moves up to the gyro's.
+        let writes: Writes = bmi(8.0, 2000.0).config_writes(200.0).collect();
+        assert_eq!(writes, [(0, 0x40, 0xA9)]);
+        // A rate that is no ODR leaves the CONF registers alone.
+        let writes: Writes = bmi(8.0, 2000.0).config_writes(1000.0).collect();
+        assert!(writes.is_empty());
+        assert_eq!(
+            ChipSettings::with_full_scale(
+                ChipModel::Bmi270,
+                FullScale {
+                    accel_g: 8.0,
+                    gyro_dps: 4000.0
+                }
+            ),
+            Err(SettingsError::GyroRange(4000.0))
+        );
+    }
+
+    #[test]
+    fn bmi270_images_decode_to_what_was_converted() {
+        let s = bmi(4.0, 125.0);
+        let sample = PhysicalSample {
+            acc: [1.0, -2.0, 9.80665],
+            gyr: [0.5, -1.0, 0.25],
+            temp_c: 31.5,
+            ..Default::default()
+        };
+        let image = s.image(&sample);
+        assert_eq!(image.len(), 14);
+        let r = s.decode(&image).unwrap();
+        for (got, want) in r.acc.iter().zip(sample.acc) {
+            assert!((got - f64::from(want)).abs() <= 9.80665 / 8192.0);
+        }
+        for (got, want) in r.gyr.iter().zip(sample.gyr) {
+            assert!((got - f64::from(want)).abs() <= (1.0f64 / 262.4).to_radians());
+        }
+        assert_eq!(r.temp_c, 31.5);
+        assert_eq!(r.mag_ut, None);
+        let mut invalid = [0u8; 14];
+        invalid[13] = 0x80;
+        assert!(s.decode(&invalid).unwrap().temp_c.is_nan());
+        assert_eq!(s.decode(&[0; 13]), None);
+        assert_eq!(
+            ChipSettings::power_on(ChipModel::Bmi270)
+                .full_scale()
+                .map(|fs| fs.accel_g),
+            Some(8.0)
+        );
     }
 }

@@ -143,7 +143,7 @@ impl ChipSetup {
             i2c_address: self.i2c_address,
             ..Configure::new(self.model, rate)
         };
-        // At most two writes: always within MAX_OVERRIDES.
+        // At most four writes: always within MAX_OVERRIDES.
         cfg.overrides.extend(self.overrides(rate));
         cfg
     }
@@ -161,7 +161,7 @@ impl ChipSetup {
             chip_select: self.chip_select,
             ..AddDevice::new(self.model, bus)
         };
-        // The same writes as Configure's (at most two): within MAX_DEVICE_OVERRIDES.
+        // The same writes as Configure's (at most four): within MAX_DEVICE_OVERRIDES.
         add.overrides.extend(self.overrides(rate));
         add
     }

@@ -1,19 +1,26 @@
 //! The 2 KB FIFO (DS: 4.7 FIFO): frames pushed at each latch, read byte by byte through
 //! FIFO_DATA, fill level in FIFO_LENGTH_0/1.
 //!
-//! At each latch one frame holds the sensors both FIFO_CONFIG_1 (fifo_gyr_en, fifo_acc_en)
-//! and PWR_CTRL enable: with headers (fifo_header_en) `0x80 | gyr << 3 | acc << 2`, then gyro
-//! X/Y/Z and accel X/Y/Z, little-endian (0x8C + 12 bytes with both); without headers the data
-//! alone. A frame that does not fit is dropped; in stream mode (FIFO_CONFIG_0
-//! fifo_stop_on_full = 0) that also sets ERR_REG.fifo_err, which a FIFO flush (CMD 0xB0) or a
-//! soft reset clears. A read of an empty FIFO returns 0x80.
+//! At each latch one frame holds the sensors FIFO_CONFIG_1 enables (fifo_gyr_en, fifo_acc_en)
+//! that have a new sample for the FIFO: a sensor that took the latch, thinned by FIFO_DOWNS
+//! (gyr_fifo_downs, acc_fifo_downs: one sample in 2^n, counted on the chip's clock as the
+//! sensors' own rates are). With headers (fifo_header_en) `0x80 | gyr << 3 | acc << 2`, then
+//! gyro X/Y/Z and accel X/Y/Z, little-endian: 0x8C + 12 bytes with both, 0x88 or 0x84 + 6
+//! with one, as ArduPilot's parser expects at accel and gyro rates that differ. Without headers
+//! a frame holds every enabled sensor that runs, the one without a new sample repeating its
+//! last value. ArduPilot's configuration (gyro 3.2 kHz, accel 1.6 kHz, FIFO_DOWNS 0x89: the
+//! gyro halved) gives one 0x8C frame every 625 µs. A frame that does not fit is dropped; in
+//! stream mode (FIFO_CONFIG_0 fifo_stop_on_full = 0) that also sets ERR_REG.fifo_err, which a
+//! FIFO flush (CMD 0xB0) or a soft reset clears. A read of an empty FIFO returns 0x80.
 //!
 //! Not emulated: the sensor time frame after the last frame (FIFO_CONFIG_0 bit 1), skip,
-//! configuration-change and drop frames, FIFO_DOWNS and different accel and gyro rates (each
-//! latch is one frame), the auxiliary sensor, the watermark and its interrupt, and stream mode
-//! discarding the oldest frames. A frame leaves the FIFO only when all its bytes were clocked
-//! out in one burst; a burst that ends inside a frame leaves it to be read again whole.
+//! configuration-change and drop frames, pre-filtered data (FIFO_DOWNS bits 3 and 7 are stored;
+//! the frames hold the filtered data of the data registers), the auxiliary sensor, the
+//! watermark and its interrupt, and stream mode discarding the oldest frames. A frame leaves
+//! the FIFO only when all its bytes were clocked out in one burst; a burst that ends inside a
+//! frame leaves it to be read again whole.
 
+use margemu_protocol::regmap::bmi270::image::field;
 use margemu_protocol::regmap::bmi270::{bits, reg, FIFO_SIZE};
 
 use super::{Bmi270, LATCH_LEN};
@@ -122,14 +129,29 @@ impl Fifo {
 }
 
 impl Bmi270 {
-    /// Pushes the frame of one latched sample (`drdy`: the sensors that produced data).
+    /// Pushes the frame of one latched sample (`drdy`: the sensors that took the latch).
     pub(super) fn fifo_push_sample(&mut self, latch: &[u8; LATCH_LEN], drdy: u8) {
         let config = self.stored(reg::FIFO_CONFIG_1);
-        let gyr = config & bits::FIFO_GYR_EN != 0 && drdy & bits::DRDY_GYR != 0;
-        let acc = config & bits::FIFO_ACC_EN != 0 && drdy & bits::DRDY_ACC != 0;
-        if !gyr && !acc {
+        let downs = self.stored(reg::FIFO_DOWNS);
+        let now = self.now_ns;
+        let gyr_downs = u32::from(downs & bits::GYR_FIFO_DOWNS);
+        let acc_downs = u32::from((downs & bits::ACC_FIFO_DOWNS) >> 4);
+        let gyr_period = self.gyro_period_ns().saturating_mul(1 << gyr_downs);
+        let acc_period = self.accel_period_ns().saturating_mul(1 << acc_downs);
+        let gyr_new = config & bits::FIFO_GYR_EN != 0
+            && drdy & bits::DRDY_GYR != 0
+            && (gyr_downs == 0 || self.ticks.fifo_gyro.take(now, gyr_period));
+        let acc_new = config & bits::FIFO_ACC_EN != 0
+            && drdy & bits::DRDY_ACC != 0
+            && (acc_downs == 0 || self.ticks.fifo_accel.take(now, acc_period));
+        if !gyr_new && !acc_new {
             return;
         }
+        let headers = config & bits::FIFO_HEADER_EN != 0;
+        // Headerless frames hold every enabled sensor that runs, the slower one repeated.
+        let pwr = self.pwr_ctrl();
+        let gyr = gyr_new || !headers && config & bits::FIFO_GYR_EN != 0 && pwr & bits::GYR_EN != 0;
+        let acc = acc_new || !headers && config & bits::FIFO_ACC_EN != 0 && pwr & bits::ACC_EN != 0;
         let mut frame = [0u8; 13];
         let mut n = 0;
         let mut append = |bytes: &[u8]| {
@@ -140,7 +162,7 @@ impl Bmi270 {
                 }
             }
         };
-        if config & bits::FIFO_HEADER_EN != 0 {
+        if headers {
             let mut header = bits::FIFO_HEADER_REGULAR;
             if gyr {
                 header |= bits::FIFO_HEADER_GYR;
@@ -151,10 +173,10 @@ impl Bmi270 {
             append(&[header]);
         }
         if gyr {
-            append(latch.get(6..12).unwrap_or(&[]));
+            append(latch.get(field::GYRO).unwrap_or(&[]));
         }
         if acc {
-            append(latch.get(0..6).unwrap_or(&[]));
+            append(latch.get(field::ACCEL).unwrap_or(&[]));
         }
         let frame = frame.get(..n).unwrap_or(&[]);
         let stop_on_full = self.stored(reg::FIFO_CONFIG_0) & bits::FIFO_STOP_ON_FULL != 0;

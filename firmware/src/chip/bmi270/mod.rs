@@ -1,9 +1,10 @@
 //! The Bosch BMI270 (accel + gyro + temperature), register by register (datasheet
 //! BST-BMI270-DS000, "DS"; register map [`margemu_protocol::regmap::bmi270`]).
 //!
-//! [`Bmi270`] serves [`SpiTarget`](super::SpiTarget): the first byte is `0x80 | address` to
+//! [`Bmi270`] serves [`SpiTarget`](super::SpiTarget) (the first byte is `0x80 | address` to
 //! read, `address` to write; bursts move to the next register except on the FIFO_DATA and
-//! INIT_DATA ports.
+//! INIT_DATA ports) and [`I2cTarget`](super::I2cTarget) (0x68, or 0x69 with SDO high; see
+//! `i2c.rs`), and stands behind the chip boundary as [`Chip`](super::Chip).
 //!
 //! **Interface selection** (DS: 4.4 primary interface). After power-on and after a soft reset
 //! the chip listens on I2C; a rising edge of chip select switches it to SPI, which is why
@@ -12,10 +13,10 @@
 //! read returns 0x00 whatever the register, and a write is lost. The soft reset's own
 //! transaction does not count as the switching edge: the chip is still resetting when chip
 //! select rises, so a driver needs another dummy read after CMD = 0xB6, as Betaflight and
-//! ArduPilot do.
+//! ArduPilot do. The I2C target answers in either mode (the datasheet does not say it stops).
 //!
 //! **Dummy byte** (DS: 6.2 SPI). In SPI mode every read clocks out one dummy byte (0x00 here)
-//! before the data of the addressed register; writes have none.
+//! before the data of the addressed register; writes have none, and I2C reads have none.
 //!
 //! **Configuration upload** (DS: 4.2 initialization). INIT_CTRL = 0 prepares a load (INTERNAL_STATUS
 //! message 0x00, not_init); each burst written to INIT_DATA lands at the byte offset
@@ -26,27 +27,47 @@
 //! to one of the known file lengths ([`CONFIG_FILE_LENS`]) without gap, 0x02 (init_err)
 //! otherwise (absent, truncated, or past the RAM).
 //!
-//! **Samples.** The board calls [`Bmi270::latch_at`] once per sample period
-//! ([`Bmi270::sample_period_ns`]). A latch converts through the shared `regmap` conversions at
-//! the configured ranges, writes the enabled sensors (PWR_CTRL acc_en, gyr_en; the temperature
-//! when temp_en or a sensor is on) little-endian into 0x0C..=0x17 and 0x22/0x23, and sets
-//! STATUS drdy_acc / drdy_gyr, which a read of that sensor's data clears. The registers swap in
-//! one step when the bus is idle: a burst in progress completes with the old sample. SENSORTIME
-//! (0x18..=0x1A) counts the chip's time (moved by latches and [`Bmi270::advance`]) at 39.0625 µs
-//! per LSB; reading SENSORTIME_0 holds the value for the rest of the burst.
+//! **Before init_ok the sensors do not run.** The datasheet's bring-up (DS: 4.2) loads the
+//! configuration file before any sensor is enabled, and users who skip it or whose upload fails
+//! report data registers that stay 0 with the sensors enabled (Bosch community threads "BMI270
+//! Config File" and "Reading Accelerometer/Gyroscope Registers BMI-270"). So
+//! until INTERNAL_STATUS reads init_ok, latches change nothing a driver can see: the data
+//! registers keep their reset value 0, TEMPERATURE its invalid 0x8000, STATUS raises no drdy,
+//! the FIFO stays empty (FIFO_DATA reads 0x80) and no interrupt fires. SENSORTIME runs
+//! regardless. A soft reset clears init_ok.
 //!
-//! **FIFO** (2 KB): headered (0x8C + gyro + accel) or headerless frames pushed
-//! at each latch, FIFO_LENGTH_0/1 in bytes, FIFO_DATA (a frame leaves once read whole), ERR_REG
+//! **Samples.** The board calls [`Bmi270::latch_image_at`] (a finished
+//! [register image](margemu_protocol::regmap::bmi270::image)) or [`Bmi270::latch_at`] (a
+//! physical sample, converted at the configured ranges) once per sample period
+//! ([`Bmi270::sample_period_ns`]: the gyro ODR, or the accel ODR when only the accel runs).
+//! A latch writes the enabled sensors (PWR_CTRL acc_en, gyr_en) little-endian into
+//! 0x0C..=0x17, and sets STATUS drdy_acc / drdy_gyr, which a read of that sensor's data clears.
+//! Each sensor keeps its own rate, on the chip's clock (`sample.rs`): the gyro takes every
+//! latch; the accelerometer, whose ODR stops at 1.6 kHz and may be set below the gyro's, takes
+//! a latch only when one of its own periods (multiples of its ODR period from time 0) has
+//! begun since its last sample, so at gyro 3.2 kHz / accel 800 Hz it takes every fourth image's
+//! accel and keeps reading the older value in between; the temperature (when temp_en or a
+//! sensor is on) is taken at most every 10 ms (ArduPilot's driver: "temperature sensor updated
+//! every 10ms"). The registers swap in one step when the bus is idle: a burst in progress
+//! completes with the old sample. SENSORTIME (0x18..=0x1A) counts the chip's time (moved by
+//! latches and [`Bmi270::advance`]) at 39.0625 µs per LSB; reading SENSORTIME_0 holds the value
+//! for the rest of the burst.
+//!
+//! **FIFO** (2 KB, `fifo.rs`): headered frames (0x8C gyro + accel, 0x88 gyro, 0x84 accel) or
+//! headerless ones, pushed with the sensors that have a new sample in the FIFO's own rate
+//! (FIFO_DOWNS), FIFO_LENGTH_0/1 in bytes, FIFO_DATA (a frame leaves once read whole), ERR_REG
 //! fifo_err on a stream-mode overflow, CMD 0xB0 flush.
 //!
+//! **Interrupts** (`interrupts.rs`): data ready sets INT_STATUS_1 acc_drdy / gyr_drdy and, mapped
+//! by INT_MAP_DATA, drives INT1/INT2 as INTx_IO_CTRL says, pulsed or latched (INT_LATCH).
+//!
 //! **Not emulated yet**: the FIFO's special frames (sensor time, skip, configuration change),
-//! FIFO_DOWNS and the watermark, the other ERR_REG bits, interrupts and the INT pins,
-//! the features of the configuration file (FEATURES pages are plain storage), the time the
-//! initialization takes (INTERNAL_STATUS changes at once), the 450 µs write spacing of the
-//! low-power mode (PWR_CONF adv_power_save is stored only), the I2C target, the auxiliary
-//! interface, self-test and the offsets. Reading INIT_DATA returns 0. Gating the data on a
-//! successful initialization is not modelled: the sensors run once PWR_CTRL enables them.
-//! Bytes written to INIT_DATA are not put in the write log (an 8 KB upload would flush it).
+//! pre-filtered FIFO data (FIFO_DOWNS filt bits are stored; the data is the filtered one) and
+//! the watermark and full interrupts, the other ERR_REG bits, the features of the configuration
+//! file (FEATURES pages are plain storage), the time the initialization takes (INTERNAL_STATUS
+//! changes at once), the 450 µs write spacing of the low-power mode (PWR_CONF adv_power_save is
+//! stored only), the auxiliary interface, self-test and the offsets. Reading INIT_DATA returns
+//! 0. Bytes written to INIT_DATA are not put in the write log (an 8 KB upload would flush it).
 //!
 //! Driver sequences read (no code taken): ArduPilot
 //! `libraries/AP_InertialSensor/AP_InertialSensor_BMI270.cpp`, Betaflight
@@ -67,19 +88,29 @@
 //! };
 //! assert_eq!(spi(&mut chip, &[0x80, 0x00, 0x00]), [0, 0, 0]); // I2C mode: nothing driven
 //! assert_eq!(spi(&mut chip, &[0x80, 0x00, 0x00]), [0, 0, 0x24]); // dummy byte, CHIP_ID
+//! spi(&mut chip, &[0x59, 0x00]); // INIT_CTRL 0: prepare the upload
+//! let mut upload = vec![0x5E]; // INIT_DATA, then a 328-byte configuration file
+//! upload.resize(1 + 328, 0xC8);
+//! spi(&mut chip, &upload);
+//! spi(&mut chip, &[0x59, 0x01]); // INIT_CTRL 1: INTERNAL_STATUS init_ok
+//! assert_eq!(spi(&mut chip, &[0x80 | 0x21, 0, 0])[2], 0x01);
 //! spi(&mut chip, &[0x7D, 0x0E]); // PWR_CTRL: accel, gyro, temperature
 //! let sample = PhysicalSample { acc: [0.0, 0.0, 9.80665], temp_c: 23.0, ..Default::default() };
 //! chip.latch_at(&sample, 1_000_000);
 //! assert_eq!(spi(&mut chip, &[0x80 | 0x10, 0, 0, 0])[2..], [0x00, 0x10]); // ACC_Z: 4096 (±8 g)
 //! ```
 
+mod boundary;
 mod fifo;
+mod i2c;
+mod interrupts;
 mod registers;
 mod sample;
 mod spi;
 mod upload;
 
-use margemu_protocol::regmap::bmi270::{bits, reg, Odr, DATA_LEN, I2C_ADDRESS};
+use margemu_protocol::regmap::bmi270::image::{ImageConfig, IMAGE_LEN};
+use margemu_protocol::regmap::bmi270::{bits, reg, AccRange, GyrRange, Odr, I2C_ADDRESSES};
 
 pub use margemu_protocol::regmap::bmi270::CONFIG_FILE_LENS;
 
@@ -87,18 +118,30 @@ use super::spi_phase::SpiPhase;
 use super::write_log::{RegisterWrite, WriteLog};
 use super::PhysicalSample;
 use fifo::Fifo;
+use i2c::I2cState;
+use interrupts::Interrupts;
+use sample::Ticks;
 use spi::Dummy;
 use upload::Upload;
 
 /// Capacity of the register write log (entries of 4 bytes).
 pub const WRITE_LOG_LEN: usize = 128;
 
-/// Data registers 0x0C..=0x17 and the temperature 0x22/0x23, as one latched sample.
-const LATCH_LEN: usize = DATA_LEN + 2;
+/// Data registers 0x0C..=0x17 and the temperature 0x22/0x23, as one latched sample (the
+/// image's layout).
+const LATCH_LEN: usize = IMAGE_LEN;
+
+/// What makes one emulated part differ from another.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Config {
+    /// The SDO pin: I2C address 0x69 when high, 0x68 when low.
+    pub sdo: bool,
+}
 
 /// The emulated BMI270 (see the [module docs](self)).
 #[derive(Clone, Debug)]
 pub struct Bmi270 {
+    config: Config,
     regs: [u8; 128],
     /// A newer sample waiting for the bus to go idle: data registers, temperature, STATUS bits.
     pending: Option<([u8; LATCH_LEN], u8)>,
@@ -111,8 +154,11 @@ pub struct Bmi270 {
     sensortime_hold: Option<u32>,
     upload: Upload,
     fifo: Fifo,
+    ticks: Ticks,
+    int: Interrupts,
     now_ns: u64,
     spi: SpiPhase,
+    i2c: I2cState,
     log: WriteLog<WRITE_LOG_LEN>,
 }
 
@@ -123,9 +169,15 @@ impl Default for Bmi270 {
 }
 
 impl Bmi270 {
-    /// A BMI270 just powered on.
+    /// A BMI270 just powered on, SDO low.
     pub fn new() -> Self {
+        Self::with_config(Config::default())
+    }
+
+    /// A chip of the given configuration just powered on.
+    pub fn with_config(config: Config) -> Self {
         let mut chip = Self {
+            config,
             regs: [0; 128],
             pending: None,
             spi_mode: false,
@@ -134,8 +186,11 @@ impl Bmi270 {
             sensortime_hold: None,
             upload: Upload::default(),
             fifo: Fifo::default(),
+            ticks: Ticks::default(),
+            int: Interrupts::default(),
             now_ns: 0,
             spi: SpiPhase::Idle,
+            i2c: I2cState::default(),
             log: WriteLog::new(),
         };
         chip.soft_reset();
@@ -146,11 +201,22 @@ impl Bmi270 {
     pub fn power_cycle(&mut self) {
         self.soft_reset();
         self.spi = SpiPhase::Idle;
+        self.i2c = I2cState::default();
     }
 
-    /// The 7-bit I2C address (SDO low).
+    /// The configuration the chip was built with.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The 7-bit I2C address (0x68, or 0x69 with SDO high).
     pub fn i2c_address(&self) -> u8 {
-        I2C_ADDRESS
+        let [low, high] = I2C_ADDRESSES;
+        if self.config.sdo {
+            high
+        } else {
+            low
+        }
     }
 
     /// Whether a chip-select edge has switched the interface to SPI.
@@ -158,7 +224,13 @@ impl Bmi270 {
         self.spi_mode
     }
 
-    /// The value a bus read of `addr` would return, without side effects.
+    /// Whether INTERNAL_STATUS reads init_ok: the sensors run.
+    pub fn is_initialized(&self) -> bool {
+        self.stored(reg::INTERNAL_STATUS) & bits::MSG_MASK == bits::MSG_INIT_OK
+    }
+
+    /// The value a bus read of `addr` would return, without side effects (and without the SPI
+    /// dummy byte).
     pub fn peek(&self, addr: u8) -> u8 {
         self.value_of(addr)
     }
@@ -171,19 +243,32 @@ impl Bmi270 {
     /// The sample period: the gyro ODR when the gyro is on, else the accel ODR when the
     /// accel is on; `None` when both are off.
     pub fn sample_period_ns(&self) -> Option<u64> {
-        let conf = if self.pwr_ctrl() & bits::GYR_EN != 0 {
-            reg::GYR_CONF
+        if self.pwr_ctrl() & bits::GYR_EN != 0 {
+            Some(self.gyro_period_ns())
         } else if self.pwr_ctrl() & bits::ACC_EN != 0 {
-            reg::ACC_CONF
+            Some(self.accel_period_ns())
         } else {
-            return None;
-        };
-        Odr::from_conf(self.stored(conf)).map(Odr::period_ns)
+            None
+        }
+    }
+
+    /// The ranges a physical sample is converted with right now: what the host needs to
+    /// predict a register image.
+    pub fn image_config(&self) -> ImageConfig {
+        ImageConfig {
+            acc_range: AccRange::from_reg(self.stored(reg::ACC_RANGE)),
+            gyr_range: GyrRange::from_reg(self.stored(reg::GYR_RANGE)),
+        }
     }
 
     /// Latches `sample` at chip time `now_ns` (see the [module docs](self)).
     pub fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64) {
         self.latch_physical(sample, now_ns);
+    }
+
+    /// Latches a finished register image taken at `now_ns` (source mode (a)).
+    pub fn latch_image_at(&mut self, image: &[u8; IMAGE_LEN], now_ns: u64) {
+        self.latch_image(image, now_ns);
     }
 
     /// Moves the chip's time to `now_ns` (never backwards).
@@ -199,6 +284,17 @@ impl Bmi270 {
     /// The register write log.
     pub fn write_log(&self) -> &WriteLog<WRITE_LOG_LEN> {
         &self.log
+    }
+
+    /// The gyro ODR period (a reserved code counts as the reset value's 200 Hz).
+    fn gyro_period_ns(&self) -> u64 {
+        Odr::from_conf(self.stored(reg::GYR_CONF)).map_or(Odr::HZ200.period_ns(), Odr::period_ns)
+    }
+
+    /// The accel ODR period (a reserved code, or one above 1.6 kHz, counts as 1.6 kHz).
+    fn accel_period_ns(&self) -> u64 {
+        let odr = Odr::from_conf(self.stored(reg::ACC_CONF)).unwrap_or(Odr::HZ1600);
+        odr.period_ns().max(Odr::HZ1600.period_ns())
     }
 
     fn pwr_ctrl(&self) -> u8 {

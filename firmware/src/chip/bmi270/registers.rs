@@ -8,15 +8,29 @@
 //!
 //! - CMD 0xB6: soft reset, every register to its power-on value and the interface back to I2C;
 //!   the write log is kept. CMD 0xB0: FIFO flush. Other commands are ignored.
+//! - INT_STATUS_1 reads the data-ready flags (`interrupts.rs`) and clears them.
+//! - A write to a register that sets a rate or a source (ACC_CONF, GYR_CONF, FIFO_DOWNS,
+//!   FIFO_CONFIG_1, PWR_CTRL) restarts the slower sensors' and the FIFO's dividers: the next
+//!   latch takes every enabled sensor.
 //! - Read-only and reserved registers ignore writes; listed registers keep the bits outside
 //!   their fields at 0 ([`write_mask`]); CMD reads 0.
 
 use margemu_protocol::regmap::bmi270::convert::{sensortime, sensortime_bytes};
-use margemu_protocol::regmap::bmi270::{bits, reg, reset_value, write_mask, I2C_ADDRESS};
+use margemu_protocol::regmap::bmi270::{bits, reg, reset_value, write_mask};
 
 use super::super::{Bus, RegisterWrite};
+use super::sample::Ticks;
 use super::upload::Upload;
 use super::Bmi270;
+
+/// Registers whose write restarts the rate dividers.
+const RATE_REGISTERS: [u8; 5] = [
+    reg::ACC_CONF,
+    reg::GYR_CONF,
+    reg::FIFO_DOWNS,
+    reg::FIFO_CONFIG_1,
+    reg::PWR_CTRL,
+];
 
 impl Bmi270 {
     /// Soft reset (and power-on): registers to their reset values, upload and latches cleared,
@@ -30,6 +44,8 @@ impl Bmi270 {
         self.fifo.flush();
         self.sensortime_hold = None;
         self.spi_mode = false;
+        self.ticks = Ticks::default();
+        self.int_reset();
     }
 
     /// What a read of `addr` returns now, without side effects.
@@ -44,6 +60,7 @@ impl Bmi270 {
                     .unwrap_or(0)
             }
             reg::FIFO_LENGTH_0 | reg::FIFO_LENGTH_1 => self.fifo_length_byte(addr),
+            reg::INT_STATUS_1 => self.int_status_1(),
             reg::FIFO_DATA => self.fifo.peek().unwrap_or(bits::FIFO_EMPTY),
             reg::CMD | reg::INIT_DATA => 0,
             _ => self.stored(addr),
@@ -71,6 +88,10 @@ impl Bmi270 {
                 self.set(reg::EVENT, 0);
                 return;
             }
+            reg::INT_STATUS_1 => {
+                self.int_status_1_read();
+                return;
+            }
             _ => return,
         };
         let status = self.stored(reg::STATUS) & !clear;
@@ -87,7 +108,7 @@ impl Bmi270 {
         }
         self.log.push(RegisterWrite {
             bus,
-            device: I2C_ADDRESS,
+            device: self.i2c_address(),
             register: addr,
             value,
         });
@@ -109,6 +130,9 @@ impl Bmi270 {
                 let mask = write_mask(addr);
                 let stored = (self.stored(addr) & !mask) | (value & mask);
                 self.set(addr, stored);
+                if RATE_REGISTERS.contains(&addr) {
+                    self.ticks = Ticks::default();
+                }
             }
         }
     }

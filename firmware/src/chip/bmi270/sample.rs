@@ -1,34 +1,85 @@
-//! One sample instant (DS: 5.2 DATA_8..19, TEMPERATURE_0/1, STATUS; PWR_CTRL): conversion at
-//! the configured ranges, little-endian data, drdy bits, and the atomic swap of the data
-//! registers when the bus is idle. A sensor that is off keeps its last data and raises no drdy.
+//! One sample instant (DS: 5.2 DATA_8..19, TEMPERATURE_0/1, STATUS; PWR_CTRL, ACC_CONF,
+//! GYR_CONF): which sensors take the latch, little-endian data, drdy bits, and the atomic swap
+//! of the data registers when the bus is idle.
+//!
+//! Nothing changes before the configuration upload has succeeded. A sensor that is off keeps
+//! its last data and raises no drdy. The gyro takes every latch (the sample clock is the
+//! gyro's ODR); the accelerometer and the temperature take a latch only when one of their own
+//! periods has begun ([`Tick`]): the accel ODR (at most 1.6 kHz) and 10 ms.
 
-use margemu_protocol::regmap::bmi270::convert::{accel_to_raw, gyro_to_raw, temp_to_raw};
-use margemu_protocol::regmap::bmi270::{bits, reg, AccRange, GyrRange, DATA_LEN};
+use margemu_protocol::regmap::bmi270::image::{field, ImageRepr, IMAGE_LEN};
+use margemu_protocol::regmap::bmi270::{bits, reg};
 
 use super::super::PhysicalSample;
 use super::{Bmi270, LATCH_LEN};
 
+/// How often the temperature register is updated, ns (ArduPilot's BMI270 driver: "temperature
+/// sensor updated every 10ms"; the BMI160 datasheet says the same of its own).
+pub const TEMP_PERIOD_NS: u64 = 10_000_000;
+
+/// A rate divider on the chip's clock: it fires at the first latch of each of its periods,
+/// the periods being the multiples of the period from time 0 (so a stream of latches at the
+/// gyro ODR gives a slower sensor every n-th latch, always the same ones).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Tick {
+    /// Where the next period begins; `None`: the next latch fires.
+    next_ns: Option<u64>,
+}
+
+impl Tick {
+    /// Whether a latch at `now_ns` is the first of a period of `period_ns`; the period is then
+    /// used up.
+    pub(super) fn take(&mut self, now_ns: u64, period_ns: u64) -> bool {
+        if self.next_ns.is_some_and(|next| now_ns < next) {
+            return false;
+        }
+        let period = period_ns.max(1);
+        self.next_ns = Some((now_ns / period).saturating_add(1).saturating_mul(period));
+        true
+    }
+}
+
+/// The dividers of the slower sensors and of the FIFO's downsampling, restarted by a soft
+/// reset and by writes to the registers that set their rates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Ticks {
+    pub(super) accel: Tick,
+    pub(super) temp: Tick,
+    pub(super) fifo_gyro: Tick,
+    pub(super) fifo_accel: Tick,
+}
+
 impl Bmi270 {
     pub(super) fn latch_physical(&mut self, sample: &PhysicalSample, now_ns: u64) {
+        let cfg = self.image_config();
+        let repr = ImageRepr::from_physical(sample.acc, sample.gyr, sample.temp_c, &cfg);
+        self.latch_image(&repr.emit(), now_ns);
+    }
+
+    pub(super) fn latch_image(&mut self, image: &[u8; IMAGE_LEN], now_ns: u64) {
         self.advance(now_ns);
-        let pwr = self.pwr_ctrl();
+        if !self.is_initialized() {
+            return;
+        }
+        let (now, pwr) = (self.now_ns, self.pwr_ctrl());
         let mut latch = self.visible_latch();
         let mut drdy = 0;
-        if pwr & bits::ACC_EN != 0 {
-            let range = AccRange::from_reg(self.stored(reg::ACC_RANGE));
-            put(&mut latch, 0, sample.acc.map(|a| accel_to_raw(a, range)));
+        let accel_period = self.accel_period_ns();
+        if pwr & bits::ACC_EN != 0 && self.ticks.accel.take(now, accel_period) {
+            copy_field(&mut latch, image, field::ACCEL);
             drdy |= bits::DRDY_ACC;
         }
         if pwr & bits::GYR_EN != 0 {
-            let range = GyrRange::from_reg(self.stored(reg::GYR_RANGE));
-            put(&mut latch, 6, sample.gyr.map(|w| gyro_to_raw(w, range)));
+            copy_field(&mut latch, image, field::GYRO);
             drdy |= bits::DRDY_GYR;
         }
-        if pwr & (bits::TEMP_EN | bits::ACC_EN | bits::GYR_EN) != 0 {
-            put(&mut latch, DATA_LEN, [temp_to_raw(sample.temp_c)]);
+        let temp_on = pwr & (bits::TEMP_EN | bits::ACC_EN | bits::GYR_EN) != 0;
+        if temp_on && self.ticks.temp.take(now, TEMP_PERIOD_NS) {
+            copy_field(&mut latch, image, field::TEMP);
         }
         self.fifo_push_sample(&latch, drdy);
-        if self.spi.is_active() {
+        self.raise_data_ready(drdy);
+        if self.spi.is_active() || self.i2c.is_active() {
             let waiting = self.pending.map_or(0, |(_, d)| d);
             self.pending = Some((latch, drdy | waiting));
         } else {
@@ -58,19 +109,40 @@ impl Bmi270 {
     }
 }
 
-/// The register of latch byte `i`: 0x0C..=0x17, then TEMPERATURE_0/1.
+/// The register of latch (image) byte `i`: 0x0C..=0x17, then TEMPERATURE_0/1.
 fn data_address(i: usize) -> u8 {
-    if i < DATA_LEN {
+    if i < field::TEMP.start {
         reg::ACC_X_LSB + i as u8
     } else {
-        reg::TEMPERATURE_0 + (i - DATA_LEN) as u8
+        reg::TEMPERATURE_0 + (i - field::TEMP.start) as u8
     }
 }
 
-/// Little-endian `values` from latch byte `at` on (bytes past the end are dropped).
-fn put<const N: usize>(latch: &mut [u8; LATCH_LEN], at: usize, values: [i16; N]) {
-    let bytes = values.iter().flat_map(|v| v.to_le_bytes());
-    for (slot, byte) in latch.iter_mut().skip(at).zip(bytes) {
-        *slot = byte;
+/// Copies the bytes of `range` from `image` into `latch`.
+fn copy_field(
+    latch: &mut [u8; LATCH_LEN],
+    image: &[u8; IMAGE_LEN],
+    range: core::ops::Range<usize>,
+) {
+    if let (Some(to), Some(from)) = (latch.get_mut(range.clone()), image.get(range)) {
+        to.copy_from_slice(from);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tick_fires_once_per_period_on_the_grid() {
+        let mut t = Tick::default();
+        let fired = (0..9u64).map(|k| t.take(k * 312_500, 1_250_000));
+        let expected = [true, false, false, false, true, false, false, false, true];
+        assert!(fired.eq(expected));
+        let mut t = Tick::default();
+        assert!(t.take(7, 10)); // the first latch fires wherever it falls
+        assert!(!t.take(9, 10));
+        assert!(t.take(10, 10));
+        assert!(t.take(u64::MAX, 0)); // no panic at the ends
     }
 }

@@ -13,7 +13,7 @@ use super::super::{Bus, SpiTarget};
 use super::Bmi270;
 
 /// The MISO value of the dummy byte (undefined in the DS).
-const DUMMY: u8 = 0x00;
+pub(super) const DUMMY: u8 = 0x00;
 
 /// Where a read is with respect to its dummy byte.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

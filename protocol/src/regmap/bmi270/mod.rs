@@ -26,6 +26,7 @@
 
 mod access;
 pub mod convert;
+pub mod image;
 mod scale;
 
 pub use access::{is_defined, is_read_only, next_address, reset_value, write_mask};
@@ -36,6 +37,9 @@ pub const CHIP_ID: u8 = 0x24;
 
 /// The 7-bit I2C address with SDO low (0x69 with SDO high).
 pub const I2C_ADDRESS: u8 = 0x68;
+
+/// Both 7-bit I2C addresses, SDO low first (DS: 6.3 I2C interface).
+pub const I2C_ADDRESSES: [u8; 2] = [0x68, 0x69];
 
 /// Size of the configuration RAM reached through INIT_DATA, in bytes (DS: 4.2 initialization:
 /// Bosch's full configuration file is 8 KB).
@@ -100,12 +104,19 @@ pub mod reg {
     pub const GYR_CONF: u8 = 0x42;
     /// Gyro range: bits 2:0 range, bit 3 OIS range.
     pub const GYR_RANGE: u8 = 0x43;
+    /// FIFO downsampling: bits 2:0 gyro, bit 3 gyro filtered data, 6:4 accel, bit 7 accel
+    /// filtered data.
+    pub const FIFO_DOWNS: u8 = 0x45;
     /// FIFO configuration 0 (bit 0 stop on full, bit 1 sensortime frame).
     pub const FIFO_CONFIG_0: u8 = 0x48;
     /// FIFO configuration 1 (bit 4 header, bits 7:5 aux/acc/gyr enables).
     pub const FIFO_CONFIG_1: u8 = 0x49;
     /// INT1 pin electrical behaviour.
     pub const INT1_IO_CTRL: u8 = 0x53;
+    /// INT2 pin electrical behaviour.
+    pub const INT2_IO_CTRL: u8 = 0x54;
+    /// Interrupt latch mode (bit 0).
+    pub const INT_LATCH: u8 = 0x55;
     /// Data interrupt mapping to INT1/INT2.
     pub const INT_MAP_DATA: u8 = 0x58;
     /// Configuration load: 0 prepares an upload, 1 starts the initialization.
@@ -176,4 +187,24 @@ pub mod bits {
     pub const FIFO_HEADER_ACC: u8 = 1 << 2;
     /// What a read of an empty FIFO returns (DS: 4.7 FIFO, over-read).
     pub const FIFO_EMPTY: u8 = 0x80;
+    /// FIFO_DOWNS: gyro downsampling exponent (2^n), bits 2:0.
+    pub const GYR_FIFO_DOWNS: u8 = 0x07;
+    /// FIFO_DOWNS: accel downsampling exponent, bits 6:4.
+    pub const ACC_FIFO_DOWNS: u8 = 0x70;
+    /// INT_STATUS_1.acc_drdy_int.
+    pub const ACC_DRDY_INT: u8 = 1 << 7;
+    /// INT_STATUS_1.gyr_drdy_int.
+    pub const GYR_DRDY_INT: u8 = 1 << 6;
+    /// INTx_IO_CTRL.lvl: active high.
+    pub const INT_LVL: u8 = 1 << 1;
+    /// INTx_IO_CTRL.od: open drain (0: push-pull).
+    pub const INT_OD: u8 = 1 << 2;
+    /// INTx_IO_CTRL.output_en.
+    pub const INT_OUTPUT_EN: u8 = 1 << 3;
+    /// INT_MAP_DATA.drdy_int1: data ready on INT1.
+    pub const DRDY_INT1: u8 = 1 << 2;
+    /// INT_MAP_DATA.drdy_int2: data ready on INT2.
+    pub const DRDY_INT2: u8 = 1 << 6;
+    /// INT_LATCH.int_latch: latched (0: non-latched).
+    pub const INT_LATCHED: u8 = 1 << 0;
 }

@@ -43,6 +43,16 @@ impl AccRange {
             Self::G16 => 2048.0,
         }
     }
+
+    /// The range, ± g.
+    pub const fn range_g(self) -> f64 {
+        match self {
+            Self::G2 => 2.0,
+            Self::G4 => 4.0,
+            Self::G8 => 8.0,
+            Self::G16 => 16.0,
+        }
+    }
 }
 
 /// Gyroscope range, GYR_RANGE bits 2:0 (codes 5–7 are reserved; read as ±125 °/s here).
@@ -97,6 +107,17 @@ impl GyrRange {
             Self::Dps125 => 262.4,
         }
     }
+
+    /// The range, ± °/s.
+    pub const fn range_dps(self) -> f64 {
+        match self {
+            Self::Dps2000 => 2000.0,
+            Self::Dps1000 => 1000.0,
+            Self::Dps500 => 500.0,
+            Self::Dps250 => 250.0,
+            Self::Dps125 => 125.0,
+        }
+    }
 }
 
 /// An output data rate, the ODR field (bits 3:0) of ACC_CONF or GYR_CONF: 100 Hz · 2^(code − 8),
@@ -124,6 +145,30 @@ impl Odr {
             code @ 0x01..=0x0D => Some(Self(code)),
             _ => None,
         }
+    }
+
+    /// The gyro rate of `hz` (within 1e-9 relative): codes 6 (25 Hz) to 13 (3.2 kHz), the
+    /// GYR_CONF codes of the Bosch sensor API (`BMI2_GYR_ODR_25HZ` ..= `BMI2_GYR_ODR_3200HZ`).
+    /// The datasheet's key features name 6.4 kHz for the gyroscope: that is its pre-filtered
+    /// data in the FIFO (FIFO_DOWNS gyr_fifo_filt_data = 0), not a GYR_CONF rate.
+    pub fn gyro_of_hz(hz: f64) -> Option<Self> {
+        Self::of_hz(hz, 0x06..=0x0D)
+    }
+
+    /// The accel rate of `hz`: codes 1 (0.78 Hz) to 12 (1.6 kHz).
+    pub fn accel_of_hz(hz: f64) -> Option<Self> {
+        Self::of_hz(hz, 0x01..=0x0C)
+    }
+
+    fn of_hz(hz: f64, codes: core::ops::RangeInclusive<u8>) -> Option<Self> {
+        codes
+            .map(Self)
+            .find(|odr| (odr.hz() - hz).abs() <= 1e-9 * hz)
+    }
+
+    /// The rate in Hz.
+    pub fn hz(self) -> f64 {
+        1e9 / self.period_ns() as f64
     }
 
     /// The ODR code.
@@ -157,6 +202,20 @@ mod tests {
         assert_eq!(Odr::HZ3200.period_ns(), 312_500);
         assert_eq!(Odr::from_conf(0x00), None);
         assert_eq!(Odr::from_conf(0x0E), None);
+    }
+
+    #[test]
+    fn rates_by_hz() {
+        assert_eq!(Odr::gyro_of_hz(3200.0), Some(Odr::HZ3200));
+        assert_eq!(Odr::gyro_of_hz(25.0), Some(Odr::HZ25));
+        assert_eq!(Odr::gyro_of_hz(12.5), None); // accel only
+        assert_eq!(Odr::gyro_of_hz(6400.0), None); // pre-filtered FIFO data only
+        assert_eq!(Odr::accel_of_hz(1600.0), Some(Odr::HZ1600));
+        assert_eq!(Odr::accel_of_hz(3200.0), None);
+        assert_eq!(Odr::accel_of_hz(0.78125).map(Odr::code), Some(1));
+        assert_eq!(Odr::gyro_of_hz(1000.0), None);
+        assert_eq!(AccRange::G4.range_g(), 4.0);
+        assert_eq!(GyrRange::Dps125.range_dps(), 125.0);
     }
 
     #[test]
