@@ -339,7 +339,17 @@ fn rig_errors_are_located() {
         "7:10",
         "within ±1 m",
     );
-    let five: String = (0..5)
+    assert_error(
+        &format!(
+            "{BASE}{}{}{}",
+            dev("model = \"icm42688p\"\n"),
+            dev("model = \"icm42688p\"\nname = \"imu2\"\nchip_select = 1\n"),
+            dev("model = \"ist8310\"\n")
+        ),
+        "14:9",
+        "the rig's images would take 70 bytes a sample; the link carries at most 64",
+    );
+    let four: String = (0..4)
         .map(|i| {
             dev(&format!(
                 "model = \"mpu6000\"\nchip_select = {}\nname = \"m{i}\"\n",
@@ -347,8 +357,8 @@ fn rig_errors_are_located() {
             ))
         })
         .collect();
-    let e = error(&format!("{BASE}{five}"));
-    assert!(e.contains("a rig has at most 4 devices"), "{e}");
+    let e = error(&format!("{BASE}{four}"));
+    assert!(e.contains("a rig has at most 3 devices"), "{e}");
     // A rate of the IMU's but not the other IMU's: located at the rate.
     assert_error(
         &format!(

@@ -408,14 +408,14 @@ fn image_batch_refusals() {
     assert_eq!(parse(0, &[]), Ok(9));
     assert_eq!(parse(32, &[0x20; 64]), Ok(73));
     assert_eq!(parse(1, &[0x01; 3]), Ok(12));
-    // A rig's image: up to 128 bytes.
+    // A rig's image: up to 64 bytes.
     assert_eq!(parse(38, &[0x5A; 76]), Ok(85));
-    assert_eq!(parse(128, &[0; 128]), Ok(137));
-    // Length 0 with images, above 128, or not dividing the images' bytes.
+    assert_eq!(parse(64, &[0; 64]), Ok(73));
+    // Length 0 with images, above 64, or not dividing the images' bytes.
     assert_eq!(parse(0, &[1]), Err(Error::InvalidValue));
     assert_eq!(parse(0, &[0; 22]), Err(Error::InvalidValue));
-    assert_eq!(parse(129, &[0; 129]), Err(Error::InvalidValue));
-    assert_eq!(parse(129, &[]), Err(Error::InvalidValue));
+    assert_eq!(parse(65, &[0; 65]), Err(Error::InvalidValue));
+    assert_eq!(parse(65, &[]), Err(Error::InvalidValue));
     assert_eq!(parse(0xFF, &[0; 255]), Err(Error::InvalidValue));
     assert_eq!(parse(22, &[0; 23]), Err(Error::PayloadTooLong));
     assert_eq!(parse(22, &[0; 14]), Err(Error::PayloadTooLong));

@@ -478,7 +478,7 @@ impl<const N: usize> Core<N> {
             return self.refuse(ErrorCode::RigRefused, seq, 4);
         }
         match self.rig.add(a) {
-            // At most MAX_DEVICES images of at most 32 bytes: within MAX_IMAGE_LEN (128).
+            // Within MAX_IMAGE_LEN (64): `Rig::add` refuses more.
             Ok(()) => session.image_len = self.rig.image_len() as u8,
             Err(e) => self.refuse(e.code, seq, e.detail),
         }

@@ -8,8 +8,9 @@
 //!
 //! Refusals of an AddDevice ([`RigError`]): the rig is full, the chip model, identity, image
 //! length or address is not one this firmware emulates (as for Configure), an override the chip
-//! has no register file for, an I2C address another device answers, or a chip select another
-//! SPI device of the added ones uses (device 0 is on chip select 0 when on SPI).
+//! has no register file for, an I2C address another device answers, a chip select another SPI
+//! device of the added ones uses (device 0 is on chip select 0 when on SPI), or a rig image that
+//! would exceed [`MAX_IMAGE_LEN`] bytes.
 //!
 //! ```
 //! use margemu_firmware::chip::{Chip, EmulatedChip};
@@ -22,6 +23,7 @@
 //! assert!(rig.add(&AddDevice::new(ChipModel::Ist8310, DeviceBus::I2c)).is_err()); // 0x0E taken
 //! ```
 
+use margemu_protocol::chip::MAX_IMAGE_LEN;
 use margemu_protocol::link::{AddDevice, DeviceBus, ErrorCode, MAX_DEVICES};
 
 use crate::chip::{Chip, EmulatedChip, RegisterWrite};
@@ -95,6 +97,9 @@ impl Rig {
             .any(|d| d.bus == DeviceBus::Spi && d.chip_select == add.chip_select);
         if add.bus == DeviceBus::Spi && taken_select {
             return Err(RigError::rig(3));
+        }
+        if self.image_len() + add.chip.image_len() > MAX_IMAGE_LEN {
+            return Err(RigError::rig(5));
         }
         for o in &add.overrides {
             if !chip.write_register(o.file, o.register, o.value) {

@@ -108,24 +108,26 @@ fn images_of_one_device_are_refused_once_the_rig_has_more() {
 
 #[test]
 fn add_device_refusals_say_why() {
-    let (mut dev, mut host) = rig();
-    // 0x0E is the IST8310's already.
+    let mut dev = Dev::new();
+    let mut host = Host::new();
+    host.hello(&mut dev, 1);
+    host.configure(&mut dev, Configure::new(ChipModel::Icm42688p, rate_1khz()));
+    let mut mpu = AddDevice::new(ChipModel::Mpu6000, DeviceBus::Spi);
+    (mpu.chip_select, mpu.i2c_address) = (1, 0x69);
+    add(&mut host, &mut dev, mpu.clone());
+    assert_eq!(errors(&poll(&mut dev, 0)), []);
+    // Chip select 1 is the MPU-6000's; I2C 0x68 is device 0's.
+    add(&mut host, &mut dev, mpu);
     add(
         &mut host,
         &mut dev,
-        AddDevice::new(ChipModel::Ist8310, DeviceBus::I2c),
+        AddDevice::new(ChipModel::Icm42688p, DeviceBus::I2c),
     );
-    // Chip select 1 is the MPU-6000's.
+    // 46 bytes of images and 32 more would exceed 64.
     let mut icm = AddDevice::new(ChipModel::Icm42688p, DeviceBus::Spi);
-    icm.chip_select = 1;
-    icm.i2c_address = 0x69;
-    add(&mut host, &mut dev, icm.clone());
-    // An identity the model does not have; an image length not the model's.
-    let wrong_id = AddDevice {
-        who_am_i: 0x12,
-        ..AddDevice::new(ChipModel::Qmc5883l, DeviceBus::I2c)
-    };
-    add(&mut host, &mut dev, wrong_id);
+    (icm.chip_select, icm.i2c_address) = (2, 0x69);
+    add(&mut host, &mut dev, icm);
+    // An image length not the model's.
     let wrong_len = AddDevice {
         image_len: 7,
         ..AddDevice::new(ChipModel::Qmc5883l, DeviceBus::I2c)
@@ -142,27 +144,30 @@ fn add_device_refusals_say_why() {
         })
         .unwrap();
     add(&mut host, &mut dev, bad_file);
-    // The fourth device fits; a fifth does not.
+    // The third device fits (52 bytes of images); a fourth does not.
     add(
         &mut host,
         &mut dev,
         AddDevice::new(ChipModel::Qmc5883l, DeviceBus::I2c),
     );
-    icm.chip_select = 2;
-    add(&mut host, &mut dev, icm);
+    add(
+        &mut host,
+        &mut dev,
+        AddDevice::new(ChipModel::Ist8310, DeviceBus::I2c),
+    );
     let out = poll(&mut dev, 0);
     assert_eq!(
         errors(&out),
         [
-            (ErrorCode::RigRefused, 2),
             (ErrorCode::RigRefused, 3),
-            (ErrorCode::UnsupportedChip, 7),
+            (ErrorCode::RigRefused, 2),
+            (ErrorCode::RigRefused, 5),
             (ErrorCode::UnsupportedChip, 7),
         ],
         "{out:?}"
     );
-    // The error queue holds four; the rest (the bad override, the fifth device) were counted.
-    assert_eq!(dev.rig().len(), 4);
+    // The error queue holds four; the rest (the bad override, the fourth device) were counted.
+    assert_eq!((dev.rig().len(), dev.rig().image_len()), (3, 52));
     assert_eq!(dev.counters().rx.rejected_messages, 6);
 }
 
@@ -193,4 +198,22 @@ fn add_device_needs_a_configured_image_session() {
     // A new Configure drops the added devices.
     host.configure(&mut dev, Configure::new(ChipModel::Mpu9250, rate_1khz()));
     assert_eq!(dev.rig().len(), 1);
+}
+
+#[test]
+fn a_rig_image_longer_than_the_link_carries_is_refused() {
+    let mut dev = Dev::new();
+    let mut host = Host::new();
+    host.hello(&mut dev, 1);
+    host.configure(&mut dev, Configure::new(ChipModel::Icm42688p, rate_1khz()));
+    let mut second = AddDevice::new(ChipModel::Icm42688p, DeviceBus::Spi);
+    (second.chip_select, second.i2c_address) = (1, 0x69);
+    add(&mut host, &mut dev, second);
+    add(
+        &mut host,
+        &mut dev,
+        AddDevice::new(ChipModel::Ist8310, DeviceBus::I2c),
+    );
+    assert_eq!(errors(&poll(&mut dev, 0)), [(ErrorCode::RigRefused, 5)]);
+    assert_eq!((dev.rig().len(), dev.rig().image_len()), (2, 64));
 }

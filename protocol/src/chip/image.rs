@@ -6,9 +6,10 @@ use core::ops::Deref;
 /// The longest image of any one model (the ICM-42688-P's 32 bytes).
 pub const MAX_CHIP_IMAGE_LEN: usize = 32;
 
-/// The longest image the link carries: a rig's, every device's image back to back
-/// ([`MAX_DEVICES`](crate::link::MAX_DEVICES) of [`MAX_CHIP_IMAGE_LEN`]).
-pub const MAX_IMAGE_LEN: usize = crate::link::MAX_DEVICES * MAX_CHIP_IMAGE_LEN;
+/// The longest image the link carries: a rig's, every device's image back to back (two of the
+/// longest, or an IMU, a second IMU and a compass). It sizes every sample slot of a device's
+/// buffer, so it stays small: a rig whose images add up to more is refused.
+pub const MAX_IMAGE_LEN: usize = 2 * MAX_CHIP_IMAGE_LEN;
 
 /// One sample's register image: `len` bytes laid out by the chip module of its model (see
 /// [`ChipModel::image_len`](super::ChipModel::image_len)), or a rig's images back to back: the

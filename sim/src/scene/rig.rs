@@ -26,8 +26,9 @@
 //! Checked across devices, each refusal located at the offending key: names unique (a name
 //! is the device's column in the logs: letters, digits, `_` and `-`), no two I2C devices
 //! answering one address (an MPU-9250 on I2C also answers 0x0C, its AK8963 in bypass mode), no
-//! two SPI devices on one chip select, and the scene's rate an output rate of every IMU in the
-//! rig (a magnetometer measures on its own schedule).
+//! two SPI devices on one chip select, the scene's rate an output rate of every IMU in the rig
+//! (a magnetometer measures on its own schedule), and the devices' images together at most
+//! [`MAX_IMAGE_LEN`] bytes (64: two ICM-42688-Ps, or an IMU, a second IMU and a compass).
 //!
 //! ```
 //! let text = "duration = 1.0\nrate = 1000.0\nseed = 1\n\
@@ -39,7 +40,7 @@
 
 use super::chip::{self, hexes, BusKind, ChipSetup, ChipSpec};
 use super::error::{PathPart, Violation};
-use margemu_protocol::chip::ChipModel;
+use margemu_protocol::chip::{ChipModel, MAX_IMAGE_LEN};
 pub use margemu_protocol::link::MAX_DEVICES;
 
 /// One device of a scene: its name in the logs and its chip.
@@ -128,6 +129,17 @@ fn resolve_all(
                 format!(
                     "chip select {} is device `{other}`'s already",
                     setup.chip_select
+                ),
+            ));
+        }
+        let image_len: usize = rig.iter().map(|d| d.chip.model.image_len()).sum();
+        let total = image_len + setup.model.image_len();
+        if total > MAX_IMAGE_LEN {
+            return Err(Violation::at_path(
+                at("model"),
+                format!(
+                    "the rig's images would take {total} bytes a sample; the link carries at \
+                     most {MAX_IMAGE_LEN}"
                 ),
             ));
         }

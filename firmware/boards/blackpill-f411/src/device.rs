@@ -15,9 +15,11 @@ use margemu_firmware::protocol::link::ResetCause;
 
 use crate::i2c;
 
-/// Samples the device buffers ahead of their instants: 32 ms at 8 kHz, more than the host's
-/// default lead (20 ms) plus one batch (32).
-pub const RING: usize = 256;
+/// Samples the device buffers ahead of their instants: 24 ms at 8 kHz, more than the host's
+/// default lead (20 ms). Each slot holds a rig's image (64 bytes): with the link handler built
+/// on the stack once before it moves to its static, a longer ring leaves the stack too little
+/// of the 128 KiB.
+pub const RING: usize = 192;
 
 static DEVICE: AtomicPtr<Device<RING>> = AtomicPtr::new(ptr::null_mut());
 

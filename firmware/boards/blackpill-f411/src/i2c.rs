@@ -1,8 +1,10 @@
-//! I2C1 as the emulated chip's I2C target, through the PAC (the HAL has no target mode): the
-//! addresses the chip answers now ([`Chip::i2c_addresses_now`]: for the MPU-9250 its own, 0x68
-//! or 0x69 with AD0, unless its I2C interface is disabled, and 0x0C for the AK8963 in bypass
-//! mode) in OAR1 and, for a second one, OAR2 (dual addressing); clock stretching on (RM0383,
-//! I2C chapter).
+//! I2C1 as the I2C target of the emulated chips, through the PAC (the HAL has no target mode):
+//! the addresses the rig's chips answer now ([`Chip::i2c_addresses_now`], device by device: for
+//! the MPU-9250 its own, 0x68 or 0x69 with AD0, unless its I2C interface is disabled, and 0x0C
+//! for the AK8963 in bypass mode; a compass's own) in OAR1 and, for a second one, OAR2 (dual
+//! addressing); clock stretching on (RM0383, I2C chapter). The peripheral owns two addresses:
+//! a rig answering more serves its first two (an IMU and its compass) and leaves the rest
+//! unacknowledged. Each transaction goes to the chip that answers the matched address.
 //!
 //! | pin | function (AF4, open drain) |
 //! |-----|----------------------------|
@@ -19,10 +21,11 @@
 //! never pops a FIFO byte the controller does not take. A NACK (AF) ends a read (STOPF is not
 //! set after a NACK: RM0383, I2C_SR1). Writes are taken at RXNE.
 
-use core::sync::atomic::{AtomicBool, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 use cortex_m::peripheral::NVIC;
 use margemu_firmware::chip::{Chip, EmulatedChip, I2cTarget};
+use margemu_firmware::link::rig::Rig;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, I2C1};
 use stm32f4xx_hal::rcc::{Enable, Rcc, Reset};
 
@@ -69,14 +72,21 @@ pub fn init(_i2c: I2C1, rcc: &mut Rcc, pclk1_hz: u32) {
     }
 }
 
-/// Follows the chip's bus state: the addresses it answers now, the first in OAR1 and a second
-/// one in OAR2 (dual addressing on); no address acknowledged when it answers none. Called with
-/// the device locked, so no transaction is being handled.
-pub fn configure(chip: &impl Chip) {
+/// The address of the transaction in progress (its START matched it).
+static ADDRESSED: AtomicU8 = AtomicU8::new(0);
+
+/// Follows the rig's bus state: the addresses its chips answer now, the first in OAR1 and a
+/// second one in OAR2 (dual addressing on); no address acknowledged when they answer none.
+/// Called with the device locked, so no transaction is being handled.
+pub fn configure(rig: &Rig) {
     let i2c = regs();
-    let mut answered = chip.i2c_addresses_now().into_iter().flatten();
+    let mut answered = rig
+        .chips()
+        .flat_map(|c| c.i2c_addresses_now())
+        .flatten();
     let (first, second) = (answered.next(), answered.next());
-    let oar1 = OAR1_KEEP | u16::from(first.unwrap_or_else(|| chip.i2c_address()) & 0x7F) << 1;
+    let fallback = rig.primary().i2c_address();
+    let oar1 = OAR1_KEEP | u16::from(first.unwrap_or(fallback) & 0x7F) << 1;
     let oar2 = second.map_or(0, |a| u16::from(a & 0x7F) << 1 | OAR2_ENDUAL);
     if i2c.oar1().read().bits() != oar1 {
         i2c.oar1().write(|w| unsafe { w.bits(oar1) });
@@ -113,17 +123,20 @@ fn I2C1_EV() {
     let Some(device) = (unsafe { device::in_i2c_handler() }) else {
         return;
     };
-    let chip = device.chip_mut();
     if sr1.addr().bit_is_set() {
         let sr2 = i2c.sr2().read(); // SR1 then SR2 clears ADDR
         let read = sr2.tra().bit_is_set();
-        // The address matched, as `configure` set it from the chip.
+        // The address matched, as `configure` set it from the rig.
         let own = if sr2.dualf().bit_is_set() {
             i2c.oar2().read().bits()
         } else {
             i2c.oar1().read().bits()
         };
         let address = (own >> 1) as u8 & 0x7F;
+        ADDRESSED.store(address, Ordering::Relaxed);
+        let Some(chip) = device.rig_mut().i2c_target(address) else {
+            return;
+        };
         chip.start(address, read);
         let cr2 = i2c.cr2().read().bits();
         if read {
@@ -135,6 +148,16 @@ fn I2C1_EV() {
         }
         return;
     }
+    let Some(chip) = device.rig_mut().i2c_target(ADDRESSED.load(Ordering::Relaxed)) else {
+        // Nobody answers the address any more (a reset mid-transaction): drain, and end.
+        if sr1.rx_ne().bit_is_set() {
+            let _ = i2c.dr().read().bits();
+        }
+        if sr1.stopf().bit_is_set() {
+            i2c.cr1().modify(|r, w| unsafe { w.bits(r.bits()) });
+        }
+        return;
+    };
     if sr1.rx_ne().bit_is_set() {
         let byte = i2c.dr().read().bits() as u8;
         chip.write(byte);
@@ -157,7 +180,9 @@ fn I2C1_ER() {
     if sr1.af().bit_is_set() {
         // SAFETY: an I2C handler at PRIORITY.
         if let Some(device) = unsafe { device::in_i2c_handler() } {
-            end(device.chip_mut());
+            if let Some(chip) = device.rig_mut().i2c_target(ADDRESSED.load(Ordering::Relaxed)) {
+                end(chip);
+            }
         }
     }
 }

@@ -24,8 +24,10 @@ use crate::chip::ChipModel;
 use crate::link::wire::{Reader, Writer};
 use crate::link::Error;
 
-/// Most devices of one rig, the one Configure names included.
-pub const MAX_DEVICES: usize = 4;
+/// Most devices of one rig, the one Configure names included: an IMU, a second IMU and a
+/// compass. Each device's chip is held by the device at the size of the largest model, so the
+/// rig's size weighs on a small board's RAM.
+pub const MAX_DEVICES: usize = 3;
 
 /// Most register overrides of one [`AddDevice`].
 pub const MAX_DEVICE_OVERRIDES: usize = 8;

@@ -125,7 +125,7 @@ impl<'a> ImageItems<'a> {
         if image_len == 0 && !self.is_empty() {
             return Err(Error::InvalidValue);
         }
-        // image_len ≤ MAX_IMAGE_LEN (128) by construction of `Image`.
+        // image_len ≤ MAX_IMAGE_LEN (64) by construction of `Image`.
         w.u8(image_len as u8)?;
         match self.repr {
             ImagesRepr::Values(v) => v.iter().try_for_each(|image| {

@@ -308,8 +308,9 @@ code_enum! {
         /// Anything else.
         Internal = 9,
         /// [`AddDevice`](super::AddDevice) refused: the rig is full, its address or chip
-        /// select is another device's, or the source is the on-device model (`detail`: 1 full,
-        /// 2 I2C address taken, 3 chip select taken, 4 model source).
+        /// select is another device's, the source is the on-device model, or the rig's image
+        /// would be too long (`detail`: 1 full, 2 I2C address taken, 3 chip select taken, 4
+        /// model source, 5 image over [`MAX_IMAGE_LEN`](crate::chip::MAX_IMAGE_LEN)).
         RigRefused = 10,
     }
 }
