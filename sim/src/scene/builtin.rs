@@ -169,7 +169,7 @@ mod tests {
 
     #[test]
     fn unknown_arguments_list_the_built_in_names() {
-        let list = "case-study, figure3, gimbal-lock, icm42688p, mpu6000, static";
+        let list = "case-study, figure3, gimbal-lock, icm42688p, mpu6000, rig, static";
         let e = resolve(Path::new("figure4")).unwrap_err().to_string();
         assert_eq!(
             e,
