@@ -6,6 +6,8 @@
 //! at heading 0 and keeps the truth's initial heading as its yaw error. A compass the
 //! configuration names but the device lacks stops the flight controller with the reason.
 
+mod vfc_common;
+
 use margemu::evaluate::{evaluate, EvalOptions, Evaluation, LatencyMode, Source};
 use margemu::offline::{FilterKind, FilterParams};
 use margemu::scene::Scene;
@@ -15,16 +17,7 @@ use margemu_protocol::chip::ChipModel;
 use serialport::TTYPort;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
-
-/// Slow rotations on all three axes (a yaw swing of ±46° starting at 0.8·sin 0.6 = 25.9°),
-/// light noise, no perturbation, 200 Hz for 3 s.
-const MOTION: &str = "duration = 3.0\nrate = 200.0\nseed = 5\nmotion = \"kinematic\"\n\
-    [joints.roll]\ntype = \"sine\"\namplitude = 0.4\nfrequency = 0.5\n\
-    [joints.pitch]\ntype = \"sine\"\namplitude = 0.3\nfrequency = 0.4\n\
-    [joints.yaw]\ntype = \"sine\"\namplitude = 0.8\nfrequency = 0.25\nphase = 0.6\n\
-    [sensors.gyro]\nnoise_density = [0.002, 0.002, 0.002]\n\
-    [sensors.accel]\nnoise_density = [0.005, 0.005, 0.005]\n\
-    [sensors.mag]\nnoise_density = [0.001, 0.001, 0.001]\n";
+use vfc_common::GENTLE;
 
 /// The built-in `rig` scene's devices.
 const RIG: &str = "[[device]]\nname = \"imu\"\nmodel = \"icm42688p\"\nbus = \"spi\"\n\
@@ -37,7 +30,7 @@ const RIG: &str = "[[device]]\nname = \"imu\"\nmodel = \"icm42688p\"\nbus = \"sp
 const INITIAL_HEADING_DEG: f64 = 25.9;
 
 fn scene(devices: &str) -> Scene {
-    Scene::parse_str(&format!("{MOTION}{devices}"), Path::new("rig.toml")).unwrap()
+    Scene::parse_str(&format!("{GENTLE}{devices}"), Path::new("rig.toml")).unwrap()
 }
 
 fn scratch(name: &str) -> PathBuf {
