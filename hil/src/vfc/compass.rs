@@ -112,19 +112,20 @@ pub struct CompassSetup {
     pub waited_ns: u64,
 }
 
+/// The flight controller's I2C bus, on the slot.
+type Bus = bus::I2c<EmulatedChip>;
+
 /// The compass on the flight controller's I2C bus.
 pub struct Compass {
     config: CompassConfig,
     /// The rig's compass during a transaction batch; a spare part otherwise.
     slot: Shared<EmulatedChip>,
-    i2c: bus::I2c<EmulatedChip>,
+    i2c: Bus,
     /// The device-clock instant of the next poll.
     next_poll_ns: u64,
     /// Polls that found no new measurement.
     not_ready: u64,
 }
-
-type Bus = bus::I2c<EmulatedChip>;
 
 fn read(i2c: &mut Bus, address: u8, register: u8, buf: &mut [u8]) -> Result<(), String> {
     i2c.write_read(address, &[register], buf)
