@@ -166,6 +166,40 @@ fn loopback_with_a_flight_controller_on_the_icm42688p_reads_back_and_scores_its_
     assert_eq!(meta["chip"]["gyro_range_dps"].as_float(), Some(2000.0));
 }
 
+/// The built-in `rig` (an ICM-42688-P and an IST8310 compass, 1 kHz for 1 s): the flight
+/// controller reads the compass over I2C, and the report says so.
+#[test]
+fn loopback_with_a_flight_controller_on_the_rig_reads_its_compass() {
+    let dir = scratch("vfc-rig");
+    let session = dir.join("session");
+    let out = margemu(&["loopback", "rig", "-o", path(&session), "--vfc", "ekf"]);
+    let all = text(&out);
+    assert!(out.status.success(), "{all}");
+    assert!(
+        all.contains(
+            "over SPI: ICM-42688-P WHO_AM_I 0x47; compass IST8310 at I2C 0x0e (identity 0x10): "
+        ),
+        "{all}"
+    );
+    assert!(all.contains("1000 samples read"), "{all}");
+    assert!(all.contains(" 0 skipped mag"), "{all}");
+    assert!(
+        all.contains("1000 of 1000 predicted images confirmed byte for byte"),
+        "{all}"
+    );
+    // The compass's set-up and its single measurements, written over I2C at 0x0E (14).
+    let (_, writes) = csv(&session, "register_writes.csv");
+    let on_compass = |register: &str, value: &str| {
+        writes.iter().any(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            f[2] == "i2c" && f[3] == "14" && f[4] == register && f[5] == value
+        })
+    };
+    assert!(on_compass("11", "1"), "CNTL2 soft reset");
+    assert!(on_compass("65", "36"), "AVGCNTL 16 times");
+    assert!(on_compass("10", "1"), "CNTL1 single measurement");
+}
+
 #[test]
 fn loopback_refuses_a_flight_controller_on_a_chip_without_a_driver() {
     let dir = scratch("vfc-mpu6500");

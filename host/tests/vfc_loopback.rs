@@ -3,6 +3,8 @@
 //! virtual bus, a reference filter, MAVLink over a second real PTY pair, read back by the
 //! device-under-test reader, then scored against the truth with `margemu evaluate`'s library.
 
+mod vfc_common;
+
 use margemu::evaluate::Evaluation;
 use margemu::offline::{FilterKind, FilterParams};
 use margemu::scene::Scene;
@@ -12,16 +14,7 @@ use margemu_protocol::chip::ChipModel;
 use serialport::TTYPort;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
-
-/// Slow rotations on all three axes (a yaw swing of ±46°), light sensor noise, no perturbation:
-/// every filter should follow it to a fraction of a degree.
-const GENTLE: &str = "duration = 3.0\nrate = 200.0\nseed = 5\nmotion = \"kinematic\"\n\
-    [joints.roll]\ntype = \"sine\"\namplitude = 0.4\nfrequency = 0.5\n\
-    [joints.pitch]\ntype = \"sine\"\namplitude = 0.3\nfrequency = 0.4\n\
-    [joints.yaw]\ntype = \"sine\"\namplitude = 0.8\nfrequency = 0.25\nphase = 0.6\n\
-    [sensors.gyro]\nnoise_density = [0.002, 0.002, 0.002]\n\
-    [sensors.accel]\nnoise_density = [0.005, 0.005, 0.005]\n\
-    [sensors.mag]\nnoise_density = [0.001, 0.001, 0.001]\n";
+use vfc_common::GENTLE;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("margemu-vfc-{}-{name}", std::process::id()));

@@ -13,19 +13,31 @@
 //!    magnetometer the filter starts with the first sample that carries a measurement (the
 //!    AK8963 delivers its first one a period of its own after set-up; a start without it would
 //!    take yaw 0); the samples before are counted as warm-up.
-//!
-//! **Without a magnetometer** (ICM-42688-P) the filter gets a zero field with every sample. The
-//! filters of `margemu-filters` take that as an unusable magnetometer: they skip the
-//! magnetometer correction and count it (`skipped_mag`, one per sample), and the first sample
-//! sets the tilt only, at yaw 0 (TRIAD without a field). So the heading reported is the one the
-//! filters have without a magnetometer: 0 at the first sample, then the integrated gyroscope
-//! (the EKF's bias estimate is then driven by gravity alone, which does not observe the bias
-//! about the vertical). Roll and pitch are corrected by the accelerometer as with a
-//! magnetometer; the yaw error is the truth's heading at the first sample plus the drift, so
-//! compare roll and pitch (a geodesic score includes the yaw error).
 //! 3. The output: at the configured rate on the device clock, or after every sample, an
 //!    ATTITUDE and an ATTITUDE_QUATERNION (MAVLink 2, [`crate::dut::mavlink_out`]) with `time_boot_ms` =
 //!    the sample's instant; a HEARTBEAT every second. Frames go to the UART queue.
+//!
+//! **With an external compass** (a rig's IST8310, QMC5883L or RM3100, [`super::compass`]) the compass
+//! is set up once the rig is complete (the device running), then polled at every turn, before
+//! the IMU: every 10 ms on the device clock it gives a measurement, turned into the IMU's axes
+//! and stamped with the device-clock instant it was read at. Each IMU sample then goes to the
+//! filter with the newest compass reading at or before its instant, as the MPU-9250's FIFO
+//! carries the AK8963's latest measurement with every sample (sample-and-hold at the IMU's
+//! rate); the board's own magnetometer, if any, is not used. The filter starts with the first
+//! sample that has a compass reading (one compass period after set-up); the samples before
+//! are warm-up. The compass's instants follow the flight controller's turns, as a real board's
+//! periodic callback runs when its scheduler gets to it: a starved thread reads the compass
+//! late and holds the previous reading longer (the IMU's samples keep their instants).
+//!
+//! **Without a magnetometer** (an ICM-42688-P without a compass) the filter gets a zero field
+//! with every sample. The filters of `margemu-filters` take that as an unusable magnetometer:
+//! they skip the magnetometer correction and count it (`skipped_mag`, one per sample), and the
+//! first sample sets the tilt only, at yaw 0 (TRIAD without a field). So the heading reported
+//! is the one the filters have without a magnetometer: 0 at the first sample, then the
+//! integrated gyroscope (the EKF's bias estimate is then driven by gravity alone, which does
+//! not observe the bias about the vertical). Roll and pitch are corrected by the accelerometer
+//! as with a magnetometer; the yaw error is the truth's heading at the first sample plus the
+//! drift, so compare roll and pitch (a geodesic score includes the yaw error).
 //!
 //! **Time.** The flight controller's clock is the device's scene clock. A sample's instant
 //! comes from its index in the FIFO's stream at the configured rate: the first batch after
@@ -43,6 +55,7 @@
 
 use super::axes::BodySample;
 use super::board::{self, Board};
+use super::compass::{Compass, CompassSetup};
 use super::uart::UartTx;
 use super::{OutputRate, VfcConfig};
 use crate::dut::mavlink_out::{attitude, attitude_quaternion, MavlinkWriter};
@@ -71,11 +84,17 @@ pub struct FcReport {
     pub setup: Option<board::Setup>,
     /// What the `mpu9250` driver found at set-up, on an MPU-9250 ([`board::Setup::mpu9250`]).
     pub init: Option<board::InitReport>,
+    /// The rig's external compass as it answered at set-up ([`super::compass`]).
+    pub compass: Option<CompassSetup>,
+    /// Compass measurements read.
+    pub compass_readings: u64,
+    /// Compass polls that found no new measurement.
+    pub compass_not_ready: u64,
     /// Set-ups done.
     pub inits: u64,
     /// Samples read from the FIFO.
     pub samples: u64,
-    /// Samples read before the first magnetometer measurement (not filtered; chips with a
+    /// Samples read before the first magnetometer measurement (not filtered; with a
     /// magnetometer only).
     pub warmup: u64,
     /// Samples never read: flushed with an overflowing FIFO (from the gaps between the
@@ -108,6 +127,11 @@ pub struct VirtualFc {
     config: VfcConfig,
     expected: ChipSettings,
     board: Option<Board>,
+    /// The external compass, once set up.
+    compass: Option<Compass>,
+    /// Compass readings (µT, body axes) by their device-clock instant, oldest first: the newest
+    /// one at or before a sample's instant goes with it.
+    held: Vec<(u64, [f64; 3])>,
     filter: Box<dyn AttitudeFilter<f64> + Send>,
     /// Instant of the previous sample filtered, ns.
     last_ns: Option<u64>,
@@ -150,6 +174,8 @@ impl VirtualFc {
             config,
             expected,
             board: None,
+            compass: None,
+            held: Vec::new(),
             filter,
             last_ns: None,
             last_read_ns: None,
@@ -175,18 +201,22 @@ impl VirtualFc {
     }
 
     fn turn(&mut self, device: &mut Firmware) -> Result<(), String> {
-        if device.state() == DeviceState::Idle {
+        let state = device.state();
+        if state == DeviceState::Idle {
             self.board = None;
+            self.compass = None;
             return Ok(());
         }
         if self.board.is_none() {
             let board = self.set_up(device)?;
             self.board = Some(board);
         }
+        let last_served_ns = device.last_served().map_or(0, |s| s.time_ns);
+        self.read_compass(device, state, last_served_ns)?;
+        let external = self.config.compass.is_some();
         let Some(board) = &mut self.board else {
             return Ok(());
         };
-        let last_served_ns = device.last_served().map_or(0, |s| s.time_ns);
         let chip: &mut EmulatedChip = device.chip_mut();
         if !board.data_ready(chip)? {
             return Ok(());
@@ -196,7 +226,7 @@ impl VirtualFc {
             .read(chip)
             .map_err(|e| format!("reading the chip: {e}"))?;
         let overflows = board.overflows();
-        let with_mag = board.has_magnetometer();
+        let with_mag = board.has_magnetometer() || external;
         let bodies: Vec<BodySample> = readings
             .iter()
             .map(|r| board.to_body(r, &self.config.mag_alignment))
@@ -224,10 +254,65 @@ impl VirtualFc {
             self.update(|r| r.resyncs += 1);
         }
         self.clock = Some(clock);
-        for (t_ns, body) in times.into_iter().zip(bodies) {
+        let newest_ns = times.last().copied().unwrap_or_default();
+        for (t_ns, mut body) in times.into_iter().zip(bodies) {
+            if external {
+                body.mag_ut = self.held_at(t_ns).unwrap_or_default();
+            }
             self.take(t_ns, body, with_mag);
         }
+        if let Some(i) = self.held.iter().rposition(|(t, _)| *t <= newest_ns) {
+            self.held.drain(..i);
+        }
         Ok(())
+    }
+
+    /// Sets the rig's external compass up once the rig is complete (the device no longer
+    /// `Configured`: AddDevice is refused once it runs), then polls it at the device-clock
+    /// instant `now_ns`; a reading is held from that instant on.
+    fn read_compass(
+        &mut self,
+        device: &mut Firmware,
+        state: DeviceState,
+        now_ns: u64,
+    ) -> Result<(), String> {
+        let Some(config) = &self.config.compass else {
+            return Ok(());
+        };
+        if self.compass.is_none() {
+            if state == DeviceState::Configured {
+                return Ok(());
+            }
+            let (compass, setup) = Compass::init(device.rig_mut(), config, now_ns)?;
+            self.compass = Some(compass);
+            self.held.clear();
+            self.update(|r| r.compass = Some(setup));
+        }
+        let Some(compass) = &mut self.compass else {
+            return Ok(());
+        };
+        let before = compass.not_ready();
+        let reading = compass.poll(device.rig_mut(), now_ns)?;
+        let not_ready = compass.not_ready();
+        if let Some(mag) = reading {
+            self.held.push((now_ns, mag));
+        }
+        if reading.is_some() || not_ready != before {
+            self.update(|r| {
+                r.compass_readings += u64::from(reading.is_some());
+                r.compass_not_ready = not_ready;
+            });
+        }
+        Ok(())
+    }
+
+    /// The compass reading held at `t_ns`: the newest one at or before it.
+    fn held_at(&self, t_ns: u64) -> Option<[f64; 3]> {
+        self.held
+            .iter()
+            .rev()
+            .find(|(t, _)| *t <= t_ns)
+            .map(|(_, mag)| *mag)
     }
 
     /// One sample read, at the instant `t_ns`: counted, then filtered and sent.
@@ -404,13 +489,24 @@ impl std::fmt::Display for FcReport {
                 "{} WHO_AM_I {:#04x}{}",
                 s.model.part_name(),
                 s.who_am_i,
-                if s.model.has_magnetometer() {
+                if s.model.has_magnetometer() || self.compass.is_some() {
                     ""
                 } else {
                     ", no magnetometer (heading from the gyroscope alone)"
                 }
             )?,
             (None, None) => f.write_str("chip never set up")?,
+        }
+        if let Some(c) = &self.compass {
+            write!(
+                f,
+                "; compass {} at I2C {:#04x} (identity {:#04x}): {} readings, {} not ready",
+                c.model.part_name(),
+                c.address,
+                c.identity,
+                self.compass_readings,
+                self.compass_not_ready
+            )?;
         }
         let sent: Vec<String> = self.sent.iter().map(|(m, n)| format!("{m} {n}")).collect();
         let d = &self.diagnostics;

@@ -1,12 +1,12 @@
 //! The virtual flight controller: a device under test that reads the emulated chip through a
 //! third-party driver crate over the virtual bus (`mpu9250` for the MPU-9250, `icm426xx` for the
-//! ICM-42688-P), runs a reference filter, and sends MAVLink ATTITUDE and ATTITUDE_QUATERNION
-//! over a pseudo-terminal, like a real board would.
+//! ICM-42688-P) and, on a rig, its external compass over I2C, runs a reference filter, and sends
+//! MAVLink ATTITUDE and ATTITUDE_QUATERNION over a pseudo-terminal, like a real board would.
 //!
 //! In loopback the firmware's link handler ([`crate::loopback`]) runs in a thread and latches
 //! the host's register images into its chip at their instants. The flight controller
 //! ([`fc::VirtualFc`]) runs in that same thread, at every turn of the device's loop, and sees
-//! the chip only as a board does:
+//! the chips only as a board does:
 //!
 //! - [`board`]: one board per chip model, chosen by the model of the device's chip. On the
 //!   MPU-9250 ([`board::mpu9250`]) the unmodified `mpu9250` crate initialises the chip (reset,
@@ -19,6 +19,11 @@
 //!   the driver (SPI). Every value comes from the chip's registers through margemu's
 //!   embedded-hal adapters, never from the host's predicted samples, and is converted by the
 //!   chip module (`margemu_protocol::regmap`) or the driver, never by the board;
+//! - [`compass`]: a rig's external compass (an IST8310 or a QMC5883L among the scene's
+//!   `[[device]]`s), found at its I2C address in the device's rig, identified, set up and read
+//!   at 100 Hz with raw register transactions as ArduPilot's compass backends do, each reading
+//!   turned from the compass's axes into the IMU's with both devices' scene rotations
+//!   ([`CompassConfig`]: what a real flight controller's configuration tells it);
 //! - [`axes`]: the body frame, and the magnetometer's axes turned into it ([`MagAlignment`], by
 //!   default the chip module's own mapping of the AK8963);
 //! - the filter: ECF, GDA or EKF of `margemu-filters` in `f64`, with the parameters of
@@ -34,18 +39,30 @@
 //! [`image_settings`]. The flight controller checks, after set-up, that the chip converts
 //! exactly that way, and stops the device with the reason if not.
 //!
-//! **The ICM-42688-P has no magnetometer.** The filters then run on gyroscope and accelerometer
-//! alone (see [`fc`]): roll and pitch as with a magnetometer, the heading from the gyroscope
-//! alone, 0 at the first sample. A score of such a run carries the truth's initial heading and
-//! the yaw drift in its yaw and geodesic errors; roll and pitch are the comparable ones.
+//! **The magnetometer.** When the scene's rig has an external compass, the filter takes its
+//! field with every IMU sample (the newest reading, held between the compass's 10 ms
+//! readings; see [`fc`]) and the board's own magnetometer is not used, as a flight controller
+//! prefers its external compass. Otherwise the MPU-9250's AK8963 comes with every FIFO record.
+//! **The ICM-42688-P has no magnetometer:** alone, the filters run on gyroscope and
+//! accelerometer (see [`fc`]): roll and pitch as with a magnetometer, the heading from the
+//! gyroscope alone, 0 at the first sample. A score of such a run carries the truth's initial
+//! heading and the yaw drift in its yaw and geodesic errors; roll and pitch are the comparable
+//! ones. With the rig's compass (the built-in scene `rig`: an ICM-42688-P and an IST8310
+//! mounted upside down) the heading is the compass's, and the whole attitude is comparable.
+//!
+//! A compass the configuration names but the device does not have (nothing answers its
+//! address, or another identity does) stops the flight controller with the reason once the
+//! device runs.
 
 pub mod axes;
 pub mod board;
+pub mod compass;
 pub mod fc;
 pub mod rig;
 pub mod uart;
 
 pub use axes::MagAlignment;
+pub use compass::CompassConfig;
 pub use fc::{FcReport, VirtualFc};
 pub use rig::{attach, run_loopback, spawn, AttachedDut, FcOutcome, VfcError, VfcRig, VfcRun};
 
@@ -110,11 +127,15 @@ pub struct VfcConfig {
     pub mag_alignment: MagAlignment,
     /// The sample rate the board asks of the chip (Hz): the scene's output rate.
     pub sample_rate_hz: f64,
+    /// The rig's external compass, read instead of the board's magnetometer
+    /// ([`compass`]); `None`: the board's own (or none).
+    pub compass: Option<CompassConfig>,
 }
 
 impl VfcConfig {
     /// `filter` on `scene`: the scene's field direction and rate, 50 Hz output, the MPU-9250's
-    /// magnetometer alignment.
+    /// magnetometer alignment, and the rig's external compass if it has one
+    /// ([`CompassConfig::for_scene`]).
     pub fn for_scene(scene: &Scene, filter: FilterParams) -> Self {
         Self {
             filter,
@@ -122,6 +143,7 @@ impl VfcConfig {
             output: OutputRate::default(),
             mag_alignment: MagAlignment::default(),
             sample_rate_hz: scene.clock.hz(),
+            compass: CompassConfig::for_scene(scene),
         }
     }
 }
@@ -145,13 +167,24 @@ pub fn image_settings(scene: &Scene) -> Result<ImageSettings, board::NoBoard> {
     })
 }
 
-/// Whether the chip of the session in `dir` has a magnetometer, by `meta.toml`'s `[chip]
-/// model`; `true` when that cannot be read (the MPU-9250, the default chip, has one).
+/// Whether the flight controller of the session in `dir` had a magnetometer: its chip's own
+/// (`meta.toml`'s `[chip] model`) or a rig's external compass (a magnetometer among
+/// `[[other_devices]]`); `true` when that cannot be read (the MPU-9250, the default chip, has
+/// one).
 pub fn session_has_magnetometer(dir: &std::path::Path) -> bool {
-    let model = margemu_sim::meta::read(dir)
-        .ok()
-        .and_then(|meta| margemu_protocol::chip::ChipModel::from_name(&meta.session()?.chip.model));
-    model.is_none_or(|m| m.has_magnetometer())
+    use margemu_protocol::chip::ChipModel;
+    let Some(meta) = margemu_sim::meta::read(dir).ok() else {
+        return true;
+    };
+    let Some(session) = meta.session() else {
+        return true;
+    };
+    let model = |name: &str| ChipModel::from_name(name);
+    let external = session
+        .other_devices
+        .iter()
+        .any(|d| model(&d.model).is_some_and(ChipModel::is_magnetometer_only));
+    external || model(&session.chip.model).is_none_or(ChipModel::has_magnetometer)
 }
 
 #[cfg(test)]

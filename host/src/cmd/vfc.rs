@@ -13,7 +13,8 @@ use std::path::{Path, PathBuf};
 pub struct VfcArgs {
     /// Run a virtual flight controller with this filter on the emulated chip: its driver over
     /// the virtual bus (`mpu9250` on the MPU-9250; `icm426xx` on the ICM-42688-P, which has no
-    /// magnetometer: heading from the gyroscope alone, compare roll and pitch), MAVLink
+    /// magnetometer: heading from the gyroscope alone, compare roll and pitch; on a rig, its
+    /// IST8310 or QMC5883L compass over I2C gives the heading), MAVLink
     /// ATTITUDE/ATTITUDE_QUATERNION read back through a second PTY pair into dut_*.csv and
     /// scored at the end.
     #[arg(long, conflicts_with = "dut", value_name = "ecf|gda|ekf")]

@@ -182,9 +182,33 @@ impl ChipSetup {
     pub fn to_chip(&self, v: [f64; 3]) -> [f64; 3] {
         match &self.rotation {
             None => v,
-            Some(r) => core::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2]),
+            Some(r) => rotate(r, v),
         }
     }
+}
+
+/// `m · v`.
+pub fn rotate(m: &Rotation, v: [f64; 3]) -> [f64; 3] {
+    core::array::from_fn(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+}
+
+/// The rotation that takes a vector in the axes of a chip mounted by `from` into the axes of a
+/// chip mounted by `to` (both scene rotations, plate → chip; `None` is the plate's own axes):
+/// `R_to · R_fromᵀ`, back to the plate, then into the other chip. A flight controller turns its
+/// compass's readings into its IMU's axes so.
+///
+/// ```
+/// use margemu_sim::scene::chip::{axes_between, rotate};
+/// let flipped = [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]];
+/// let quarter = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+/// // A plate vector (1, 2, 3) reads (1, −2, −3) on the flipped chip and (2, −1, 3) on the other.
+/// let m = axes_between(Some(flipped), Some(quarter));
+/// assert_eq!(rotate(&m, [1.0, -2.0, -3.0]), [2.0, -1.0, 3.0]);
+/// ```
+pub fn axes_between(from: Option<Rotation>, to: Option<Rotation>) -> Rotation {
+    const IDENTITY: Rotation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let (f, t) = (from.unwrap_or(IDENTITY), to.unwrap_or(IDENTITY));
+    core::array::from_fn(|i| core::array::from_fn(|j| (0..3).map(|k| t[i][k] * f[j][k]).sum()))
 }
 
 /// `scene` with its chip replaced by `name` at power-on on SPI (the scene's rotation kept), as

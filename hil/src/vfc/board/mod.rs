@@ -7,6 +7,10 @@
 //! | MPU-9250    | [`mpu9250`]      | `mpu9250` 0.25    | SPI (or I2C)   | AK8963, in the FIFO |
 //! | ICM-42688-P | [`icm42688p`]    | `icm426xx` 0.4    | SPI            | none              |
 //!
+//! A rig's external compass (IST8310, QMC5883L, RM3100) is not the board's: the flight controller
+//! reads it on its own I2C bus ([`super::compass`]) and, when there is one, uses it instead of
+//! the board's magnetometer.
+//!
 //! [`Board`] is the chip-generic face the flight controller ([`super::fc`]) sees:
 //! [`Board::init`] sets the device's chip up through the driver and says how the chip now
 //! converts samples ([`Setup::configured`], checked against the host's images);
@@ -197,7 +201,7 @@ impl Board {
 
 /// Runs `f` with the device's `chip` in `slot` (the bus adapters' target), then puts it back:
 /// how a board's transactions reach the chip the firmware's device owns.
-fn on_bus<C, R>(slot: &crate::bus::Shared<C>, chip: &mut C, f: impl FnOnce() -> R) -> R {
+pub(super) fn on_bus<C, R>(slot: &crate::bus::Shared<C>, chip: &mut C, f: impl FnOnce() -> R) -> R {
     std::mem::swap(chip, &mut *slot.borrow_mut());
     let result = f();
     std::mem::swap(chip, &mut *slot.borrow_mut());
