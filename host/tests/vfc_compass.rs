@@ -93,6 +93,27 @@ fn errors(eval: &Evaluation) -> [(f64, f64, f64); 3] {
     })
 }
 
+/// `register_writes.csv` names the device every write reached: the IMU's SPI writes `imu`, the
+/// compass's I2C writes (0x0E) `compass`.
+fn check_written_devices(dir: &Path) {
+    let text = std::fs::read_to_string(dir.join("register_writes.csv")).unwrap();
+    let mut lines = text.lines();
+    assert!(lines.next().unwrap().ends_with(",dropped_before,device"));
+    let (mut imu, mut compass) = (0, 0);
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        match (f[2], f[3], f[7]) {
+            ("spi", "0", "imu") => imu += 1,
+            ("i2c", "14", "compass") => compass += 1,
+            other => panic!("a write named wrongly: {other:?} in {line}"),
+        }
+    }
+    assert!(
+        imu > 0 && compass > 0,
+        "{imu} IMU and {compass} compass writes"
+    );
+}
+
 #[test]
 fn the_compass_gives_the_heading_the_imu_alone_cannot() {
     let mut with = Vec::new();
@@ -110,6 +131,7 @@ fn the_compass_gives_the_heading_the_imu_alone_cannot() {
         assert!((1..=3).contains(&fc.warmup), "{fc}");
         assert_eq!((fc.samples, fc.missed), (600, 0), "{fc}");
         assert_eq!(fc.diagnostics.skipped_mag, 0, "{fc}");
+        check_written_devices(&dir);
         let e = errors(&score(&dir));
         println!(
             "{kind} with the compass: {fc}\n  RMS/max/mean (°) roll {:.2?} pitch {:.2?} yaw {:.2?}",

@@ -14,7 +14,7 @@
 //! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample and for entries the check cannot verify (see `served.rs`) |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
-//! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before`: each write of the device under test (`bus` spi, i2c or aux; `dropped_before`: writes the device lost just before this batch) |
+//! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before,device`: each write of the device under test (`bus` spi, i2c or aux; `address`: the I2C address, or on SPI the chip select of the device written, 0 for device 0; `dropped_before`: writes the device lost just before this batch; `device`: the name of the scene's device it reached, empty if none answers that address) |
 //! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `resend_out_of_window` (a hole older than the items the session keeps: not resent), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
 //!
 //! `meta.toml` ends with the `[completion]` table (status, samples written, why the session
@@ -95,7 +95,29 @@ pub const DEVICE_COLUMNS: &str =
 pub const TELEMETRY_COLUMNS: &str = "host_ns,seq,time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns";
 /// Header of `register_writes.csv`.
 pub const REGISTER_WRITES_COLUMNS: &str =
-    "host_ns,time_ns,bus,address,register,value,dropped_before";
+    "host_ns,time_ns,bus,address,register,value,dropped_before,device";
+
+/// A device of the session, as `register_writes.csv` names the device each write reached.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WrittenDevice {
+    /// Its name (the scene's `name`, or its model's).
+    pub name: String,
+    /// SPI writes of this chip select reach it (device 0: 0, as the device reports them).
+    pub chip_select: Option<u8>,
+    /// I2C writes to these addresses reach it (an MPU-9250's AK8963 included).
+    pub i2c_addresses: Vec<u8>,
+}
+
+/// The name of the device a write of `bus` to `address` (an SPI write: its chip select)
+/// reached: the first of `devices` that answers it; the auxiliary master's writes are device 0's.
+fn written_device<'a>(devices: &'a [WrittenDevice], bus: Bus, address: u8) -> &'a str {
+    let found = devices.iter().find(|d| match bus {
+        Bus::Spi => d.chip_select == Some(address),
+        Bus::I2c => d.i2c_addresses.contains(&address),
+        Bus::AuxMaster => true,
+    });
+    found.map_or("", |d| d.name.as_str())
+}
 /// Header of `events.csv`.
 pub const EVENTS_COLUMNS: &str = "host_ns,event,detail";
 
@@ -112,6 +134,8 @@ pub struct SessionLog {
     truth: TruthWriter<BufWriter<File>>,
     /// A rig's image lengths, one `sent.csv` column each (empty: one column).
     image_split: Vec<usize>,
+    /// Who register writes reach.
+    devices: Vec<WrittenDevice>,
 }
 
 fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
@@ -122,8 +146,13 @@ fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
 
 impl SessionLog {
     /// Creates `dir` and every file, with their headers (`sent`: what `sent.csv` holds), and
-    /// writes `meta.toml`.
-    pub fn create(dir: &Path, meta: &SessionMeta, sent: &SentLayout) -> io::Result<Self> {
+    /// writes `meta.toml`; `devices` name the device of each register write.
+    pub fn create(
+        dir: &Path,
+        meta: &SessionMeta,
+        sent: &SentLayout,
+        devices: Vec<WrittenDevice>,
+    ) -> io::Result<Self> {
         let image_split = match sent {
             SentLayout::Images(devices) if devices.len() > 1 => {
                 devices.iter().map(|(_, len)| *len).collect()
@@ -146,6 +175,7 @@ impl SessionLog {
                 File::create(dir.join(TRUTH_FILE))?,
             ))?,
             image_split,
+            devices,
         };
         log.flush()?;
         Ok(log)
@@ -304,9 +334,10 @@ impl SessionLog {
                 Bus::I2c => "i2c",
                 Bus::AuxMaster => "aux",
             };
+            let device = written_device(&self.devices, w.bus, w.address);
             writeln!(
                 self.register_writes,
-                "{host_ns},{},{bus},{},{},{},{dropped}",
+                "{host_ns},{},{bus},{},{},{},{dropped},{device}",
                 w.time_ns, w.address, w.register, w.value
             )?;
         }
