@@ -110,7 +110,7 @@ pub struct WrittenDevice {
 
 /// The name of the device a write of `bus` to `address` (an SPI write: its chip select)
 /// reached: the first of `devices` that answers it; the auxiliary master's writes are device 0's.
-fn written_device<'a>(devices: &'a [WrittenDevice], bus: Bus, address: u8) -> &'a str {
+fn written_device(devices: &[WrittenDevice], bus: Bus, address: u8) -> &str {
     let found = devices.iter().find(|d| match bus {
         Bus::Spi => d.chip_select == Some(address),
         Bus::I2c => d.i2c_addresses.contains(&address),
