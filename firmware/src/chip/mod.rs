@@ -35,7 +35,9 @@
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
 mod ak8963;
+pub mod bmi088;
 pub mod bmi270;
+mod bosch_spi;
 mod emulated;
 pub mod icm42688p;
 pub mod ist8310;

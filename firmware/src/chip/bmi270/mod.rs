@@ -83,11 +83,10 @@ use margemu_protocol::regmap::bmi270::{bits, reg, Odr, DATA_LEN, I2C_ADDRESS};
 
 pub use margemu_protocol::regmap::bmi270::CONFIG_FILE_LENS;
 
-use super::spi_phase::SpiPhase;
+use super::bosch_spi::BoschSpi;
 use super::write_log::{RegisterWrite, WriteLog};
 use super::PhysicalSample;
 use fifo::Fifo;
-use spi::Dummy;
 use upload::Upload;
 
 /// Capacity of the register write log (entries of 4 bytes).
@@ -102,17 +101,14 @@ pub struct Bmi270 {
     regs: [u8; 128],
     /// A newer sample waiting for the bus to go idle: data registers, temperature, STATUS bits.
     pending: Option<([u8; LATCH_LEN], u8)>,
-    /// SPI selected by a chip-select rising edge (false: I2C mode after power-on or reset).
-    spi_mode: bool,
-    /// A soft reset happened in the current transaction: its chip-select edge does not count.
-    reset_in_transaction: bool,
-    dummy: Dummy,
+    /// A soft reset was commanded over the bus, for the SPI front end to take.
+    soft_reset_seen: bool,
     /// SENSORTIME held by a read of SENSORTIME_0 until the transaction ends.
     sensortime_hold: Option<u32>,
     upload: Upload,
     fifo: Fifo,
     now_ns: u64,
-    spi: SpiPhase,
+    spi: BoschSpi,
     log: WriteLog<WRITE_LOG_LEN>,
 }
 
@@ -128,14 +124,12 @@ impl Bmi270 {
         let mut chip = Self {
             regs: [0; 128],
             pending: None,
-            spi_mode: false,
-            reset_in_transaction: false,
-            dummy: Dummy::None,
+            soft_reset_seen: false,
             sensortime_hold: None,
             upload: Upload::default(),
             fifo: Fifo::default(),
             now_ns: 0,
-            spi: SpiPhase::Idle,
+            spi: BoschSpi::new(),
             log: WriteLog::new(),
         };
         chip.soft_reset();
@@ -145,7 +139,7 @@ impl Bmi270 {
     /// Power cycle: every register to its power-on value, back in I2C mode, time kept.
     pub fn power_cycle(&mut self) {
         self.soft_reset();
-        self.spi = SpiPhase::Idle;
+        self.spi = BoschSpi::new();
     }
 
     /// The 7-bit I2C address (SDO low).
@@ -155,7 +149,7 @@ impl Bmi270 {
 
     /// Whether a chip-select edge has switched the interface to SPI.
     pub fn is_spi_mode(&self) -> bool {
-        self.spi_mode
+        self.spi.is_spi_mode()
     }
 
     /// The value a bus read of `addr` would return, without side effects.

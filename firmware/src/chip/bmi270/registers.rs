@@ -29,7 +29,6 @@ impl Bmi270 {
         self.upload = Upload::default();
         self.fifo.flush();
         self.sensortime_hold = None;
-        self.spi_mode = false;
     }
 
     /// What a read of `addr` returns now, without side effects.
@@ -95,7 +94,7 @@ impl Bmi270 {
             reg::CMD => {
                 if value == bits::CMD_SOFT_RESET {
                     self.soft_reset();
-                    self.reset_in_transaction = true;
+                    self.soft_reset_seen = true;
                 } else if value == bits::CMD_FIFO_FLUSH {
                     self.fifo_flush();
                 }

@@ -73,8 +73,7 @@ pub fn temp_from_bytes([msb, lsb]: [u8; 2]) -> Option<f32> {
     } else {
         i32::from(u11)
     };
-    (int11 != i32::from(TEMP_INVALID))
-        .then(|| int11 as f32 / TEMP_LSB_PER_K + TEMP_OFFSET_C)
+    (int11 != i32::from(TEMP_INVALID)).then(|| int11 as f32 / TEMP_LSB_PER_K + TEMP_OFFSET_C)
 }
 
 /// The specific force (m/s²) of accel data `raw`.
@@ -95,13 +94,22 @@ mod tests {
     fn accel_at_every_range() {
         for range in AccRange::ALL {
             let one_g = accel_to_raw(STANDARD_GRAVITY, range);
-            assert!((f32::from(one_g) - range.lsb_per_g()).abs() <= 0.5, "{range:?}");
+            assert!(
+                (f32::from(one_g) - range.lsb_per_g()).abs() <= 0.5,
+                "{range:?}"
+            );
             assert_eq!(accel_to_raw(-STANDARD_GRAVITY, range), -one_g);
             let back = accel_from_raw(one_g, range);
             assert!((back - STANDARD_GRAVITY).abs() < STANDARD_GRAVITY / range.lsb_per_g());
         }
-        assert_eq!(accel_to_raw(30.0 * STANDARD_GRAVITY, AccRange::G24), i16::MAX);
-        assert_eq!(accel_to_raw(-30.0 * STANDARD_GRAVITY, AccRange::G24), i16::MIN);
+        assert_eq!(
+            accel_to_raw(30.0 * STANDARD_GRAVITY, AccRange::G24),
+            i16::MAX
+        );
+        assert_eq!(
+            accel_to_raw(-30.0 * STANDARD_GRAVITY, AccRange::G24),
+            i16::MIN
+        );
         assert_eq!(accel_to_raw(f32::NAN, AccRange::G3), 0);
     }
 

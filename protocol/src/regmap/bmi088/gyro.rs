@@ -269,7 +269,11 @@ mod tests {
             500_000, 500_000, 1_000_000, 2_500_000, 5_000_000, 10_000_000, 5_000_000, 10_000_000,
         ];
         for (code, p) in (0u8..).zip(periods) {
-            assert_eq!(Bandwidth::from_reg(0x80 | code).period_ns(), p, "code {code}");
+            assert_eq!(
+                Bandwidth::from_reg(0x80 | code).period_ns(),
+                p,
+                "code {code}"
+            );
         }
         assert_eq!(Bandwidth::from_reg(0x87).filter_hz(), 32);
         assert_eq!(Bandwidth::from_reg(0x0A).code(), 2);
