@@ -104,14 +104,9 @@ fn check_accel(b: &mut Board, samples: &[PhysicalSample], lsb_per_g: f64) {
         b.clock.advance_ns(period);
         b.accel_chip.borrow_mut().latch_at(s, b.clock.now_ns());
         let got = b.accel.get_accel().expect("get_accel");
-        for axis in 0..3 {
-            let in_g = f64::from(s.acc[axis]) / G;
-            assert_within_1_lsb(
-                got[axis],
-                in_g,
-                lsb_per_g,
-                &format!("accel {i} axis {axis}"),
-            );
+        for (axis, (&raw, &a)) in got.iter().zip(&s.acc).enumerate() {
+            let what = format!("accel {i} axis {axis}");
+            assert_within_1_lsb(raw, f64::from(a) / G, lsb_per_g, &what);
         }
     }
 }
@@ -126,14 +121,9 @@ fn check_gyro(b: &mut Board, samples: &[PhysicalSample], lsb_per_dps: f64) {
         b.clock.advance_ns(period);
         b.gyro_chip.borrow_mut().latch_at(s, b.clock.now_ns());
         let got = b.gyro.get_gyro().expect("get_gyro");
-        for axis in 0..3 {
-            let dps = f64::from(s.gyr[axis]).to_degrees();
-            assert_within_1_lsb(
-                got[axis],
-                dps,
-                lsb_per_dps,
-                &format!("gyro {i} axis {axis}"),
-            );
+        for (axis, (&raw, &w)) in got.iter().zip(&s.gyr).enumerate() {
+            let what = format!("gyro {i} axis {axis}");
+            assert_within_1_lsb(raw, f64::from(w).to_degrees(), lsb_per_dps, &what);
         }
     }
 }

@@ -227,10 +227,10 @@ fn px4_gyro_fifo_read(g: &mut Bmi088Gyro) -> Option<Vec<[i16; 3]>> {
 fn assert_accel(got: &[[i16; 3]], want: &[PhysicalSample]) {
     assert_eq!(got.len(), want.len(), "accel sample count");
     for (i, (g, s)) in got.iter().zip(want).enumerate() {
-        for axis in 0..3 {
+        for (axis, (&raw, &a)) in g.iter().zip(&s.acc).enumerate() {
             let what = format!("accel sample {i} axis {axis}");
-            let in_g = f64::from(s.acc[axis]) / f64::from(G);
-            assert_within_1_lsb(g[axis], in_g, acc_lsb_per_g(3), &what);
+            let in_g = f64::from(a) / f64::from(G);
+            assert_within_1_lsb(raw, in_g, acc_lsb_per_g(3), &what);
         }
     }
 }
@@ -238,10 +238,10 @@ fn assert_accel(got: &[[i16; 3]], want: &[PhysicalSample]) {
 fn assert_gyro(got: &[[i16; 3]], want: &[PhysicalSample]) {
     assert_eq!(got.len(), want.len(), "gyro sample count");
     for (i, (g, s)) in got.iter().zip(want).enumerate() {
-        for axis in 0..3 {
+        for (axis, (&raw, &w)) in g.iter().zip(&s.gyr).enumerate() {
             let what = format!("gyro sample {i} axis {axis}");
-            let dps = f64::from(s.gyr[axis]).to_degrees();
-            assert_within_1_lsb(g[axis], dps, gyr_lsb_per_dps(0), &what);
+            let dps = f64::from(w).to_degrees();
+            assert_within_1_lsb(raw, dps, gyr_lsb_per_dps(0), &what);
         }
     }
 }

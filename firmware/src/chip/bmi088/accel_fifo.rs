@@ -88,7 +88,7 @@ impl AccelFifo {
     /// A sample's data: stored as a frame when the down-sampling factor 2^`downs` lets it in;
     /// `stop_on_full` is FIFO mode.
     pub(super) fn push_sample(&mut self, data: &[u8; 6], downs: u8, stop_on_full: bool) {
-        let due = self.samples % (1u32 << (downs & 0x07)) == 0;
+        let due = self.samples & ((1u32 << (downs & 0x07)) - 1) == 0;
         self.samples = self.samples.wrapping_add(1);
         if !due {
             return;
