@@ -28,6 +28,8 @@
 //!   packets, INT1/INT2);
 //! - [`bmi270::Bmi270`]: the Bosch BMI270 (SPI with its dummy byte and I2C-to-SPI switch, the
 //!   configuration upload, data registers and sensor time); not yet one of the [`EmulatedChip`]s.
+//! - [`bmi088::Bmi088Accel`] and [`bmi088::Bmi088Gyro`]: the Bosch BMI088's two dies, each on
+//!   its own chip select (or I2C address), each with its FIFO; not yet [`EmulatedChip`]s;
 //! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer, as an [`I2cTarget`] (not yet an
 //!   [`EmulatedChip`]);
 //! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer, likewise an [`I2cTarget`] only.

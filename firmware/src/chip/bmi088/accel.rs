@@ -1,6 +1,6 @@
 //! The accelerometer die (DS 5.2, 5.3; AN 3), register by register.
 //!
-//! - **Interface** ([`BoschSpi`]): I2C after power-on and after a soft reset, SPI from the next
+//! - **Interface** (the SPI front end shared with the BMI270): I2C after power-on and after a soft reset, SPI from the next
 //!   chip-select rising edge (DS 3, 6.1; Bosch's API reads CHIP_ID once after each soft reset for
 //!   this); every SPI read clocks out one dummy byte first (DS 6.1.2).
 //! - **Power** (DS 3, 4.1.1): the accelerometer and the temperature sensor run while
@@ -18,7 +18,7 @@
 //!   code stops the samples ([`Bmi088Accel::sample_period_ns`] is `None`).
 //! - **ACC_SOFTRESET**: 0xB6 resets every register (the write log is kept) and the interface to
 //!   I2C; 0xB0 resets the FIFO; other values are ignored. It reads 0.
-//! - **FIFO**: see [`AccelFifo`](super::accel_fifo::AccelFifo).
+//! - **FIFO**: see [`accel_fifo`](super::accel_fifo).
 //! - **INT1/INT2** ([`Bmi088Accel::int1_pin`]): an output pin (intx_out) is asserted while a
 //!   mapped source is: data ready while ACC_STATUS.acc_drdy is set (until a data register is
 //!   read), FIFO watermark while FIFO_LENGTH ≥ FIFO_WTM, FIFO full while no frame fits.

@@ -15,7 +15,7 @@
 //! - **GYRO_SOFTRESET** = 0xB6 resets every register (other values are ignored); it reads 0.
 //! - **GYRO_SELF_TEST**: rate_ok (bit 4) reads 1 in normal mode; writing trig_bist makes
 //!   bist_rdy read 1 with bist_fail 0 (the test passes at once).
-//! - **FIFO**: see [`GyroFifo`](super::gyro_fifo::GyroFifo); on only in FIFO (0x40) or stream
+//! - **FIFO**: see [`gyro_fifo`](super::gyro_fifo); on only in FIFO (0x40) or stream
 //!   (0x80) mode; writing FIFO_CONFIG_0 or FIFO_CONFIG_1 empties it and clears the overrun flag
 //!   (AN 4.3, 4.4, 4.5.9).
 //! - **INT3/INT4** ([`Bmi088Gyro::int3_pin`]): asserted while a mapped source is (the

@@ -49,10 +49,10 @@
 //! assert_eq!(spi(&mut gyro, &[0x80 | 0x06, 0, 0])[1..], [0xAB, 0x03]); // 939 (±2000 °/s)
 //! ```
 
-mod accel;
-mod accel_fifo;
-mod gyro;
-mod gyro_fifo;
+pub mod accel;
+pub mod accel_fifo;
+pub mod gyro;
+pub mod gyro_fifo;
 mod i2c;
 
 pub use accel::Bmi088Accel;
