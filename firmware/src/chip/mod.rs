@@ -29,6 +29,8 @@
 //! - [`Bmi270`]: the Bosch BMI270 (SPI with its dummy byte and I2C-to-SPI switch, I2C, the
 //!   configuration upload, data registers at the sensors' own rates, sensor time, the FIFO,
 //!   INT1/INT2 data ready);
+//! - [`bmi088::Bmi088Accel`] and [`bmi088::Bmi088Gyro`]: the Bosch BMI088's two dies, each on
+//!   its own chip select (or I2C address), each with its FIFO;
 //! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer (I2C only);
 //! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer (I2C only); both share their
 //!   [`Chip`] boundary ([`magnetometer`]) and I2C front end ([`pointer_i2c`]).
@@ -37,7 +39,9 @@
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
 mod ak8963;
+pub mod bmi088;
 pub mod bmi270;
+mod bosch_spi;
 mod emulated;
 mod i2c_pointer;
 pub mod icm42688p;
