@@ -160,7 +160,8 @@ fn spi_write(chip: &mut EmulatedChip, bytes: &[u8]) {
 
 /// `model` at power-on with its sensors on (MPU family: PWR_MGMT_1 = 0x01, awake on the PLL;
 /// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise; BMI270: the dummy read, a
-/// 328-byte configuration upload, PWR_CTRL = 0x0E; QMC5883L: CONF1 = 0x0D, continuous at
+/// 328-byte configuration upload, PWR_CTRL = 0x0E; BMI088: the accelerometer's dummy read,
+/// ACC_PWR_CONF = 0x00, ACC_PWR_CTRL = 0x04 (the gyro runs from power-on); QMC5883L: CONF1 = 0x0D, continuous at
 /// 200 Hz; IST8310: single measurements, triggered by its reader; RM3100: continuous).
 fn powered(model: ChipModel) -> EmulatedChip {
     let address = model.i2c_addresses()[0];
@@ -177,6 +178,11 @@ fn powered(model: ChipModel) -> EmulatedChip {
             spi_write(&mut chip, &upload);
             spi_write(&mut chip, &[0x59, 0x01]);
             spi_write(&mut chip, &[0x7D, 0x0E]);
+        }
+        Family::Bmi088 => {
+            spi_write(&mut chip, &[0x80, 0x00]);
+            spi_write(&mut chip, &[0x7C, 0x00]);
+            spi_write(&mut chip, &[0x7D, 0x04]);
         }
         Family::Qmc5883l => assert!(chip.write_register(0, 0x09, 0x0D)),
         Family::Ist8310 => {}

@@ -52,6 +52,7 @@ pub mod pointer_i2c;
 pub mod qmc5883l;
 pub mod rm3100;
 mod spi_phase;
+mod tick;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};

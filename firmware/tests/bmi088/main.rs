@@ -8,6 +8,7 @@
 
 #![allow(missing_docs)]
 
+mod boundary;
 mod bus;
 mod data;
 mod fifo;
@@ -45,14 +46,14 @@ pub fn dummy_read(chip: &mut impl SpiTarget) {
 }
 
 /// Reads `n` accelerometer registers from `addr`, dropping the dummy byte (which must be 0x00).
-pub fn aread(chip: &mut impl SpiTarget, addr: u8, n: usize) -> Vec<u8> {
+pub fn aread(chip: &mut (impl SpiTarget + ?Sized), addr: u8, n: usize) -> Vec<u8> {
     let bytes = spi_read(chip, addr, n + 1);
     assert_eq!(bytes.first(), Some(&0x00), "dummy byte");
     bytes[1..].to_vec()
 }
 
 /// Reads one accelerometer register.
-pub fn aread1(chip: &mut impl SpiTarget, addr: u8) -> u8 {
+pub fn aread1(chip: &mut (impl SpiTarget + ?Sized), addr: u8) -> u8 {
     aread(chip, addr, 1)[0]
 }
 

@@ -91,10 +91,11 @@ fn a_rig_image_latches_every_device_at_once() {
     let data: Vec<u8> = (0..6).map(|_| mag.read()).collect();
     mag.stop();
     assert_eq!(data, (32..38).collect::<Vec<u8>>());
-    assert!(dev
-        .rig_mut()
-        .spi_target(1)
-        .is_some_and(|c| c.model() == ChipModel::Mpu6000));
+    assert_eq!(dev.rig().spi_device(1), Some((2, 0))); // the MPU-6000
+    let mpu = dev.rig_mut().spi_target(1).unwrap();
+    mpu.select();
+    assert_eq!(mpu.exchange(0x80 | 0x75), 0x68); // WHO_AM_I, clocked out next
+    mpu.deselect();
     assert!(dev.rig_mut().spi_target(2).is_none());
 }
 

@@ -147,19 +147,26 @@ impl Bmi088Accel {
 
     /// Latches `sample` at die time `now_ns` (see the [module docs](self)).
     pub fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64) {
+        let range = AccRange::from_reg(self.regs.get(reg::ACC_RANGE));
+        let mut data = [0; DATA_LEN];
+        put_le(&mut data, sample.acc.map(|a| accel_to_raw(a, range)));
+        self.latch_data(data, temp_bytes(temp_to_raw(sample.temp_c)), now_ns);
+    }
+
+    /// Latches register values at die time `now_ns`: ACC_X..Z (`data`, as the registers hold
+    /// them) and TEMP_MSB, TEMP_LSB (`temp`, taken only when the temperature is due), as
+    /// [`Bmi088Accel::latch_at`] does with the values it converts.
+    pub fn latch_data(&mut self, data: [u8; DATA_LEN], temp: [u8; 2], now_ns: u64) {
         self.advance(now_ns);
         if !self.is_on() {
             return;
         }
-        let range = AccRange::from_reg(self.regs.get(reg::ACC_RANGE));
-        let mut data = [0; DATA_LEN];
-        put_le(&mut data, sample.acc.map(|a| accel_to_raw(a, range)));
         let temp_due = self
             .temp_at
             .is_none_or(|t| self.now_ns >= t.saturating_add(TEMP_UPDATE_NS));
         let temp = temp_due.then(|| {
             self.temp_at = Some(self.now_ns);
-            temp_bytes(temp_to_raw(sample.temp_c))
+            temp
         });
         if self.regs.get(reg::FIFO_CONFIG_1) & bits::FIFO_ACC_EN != 0 {
             let downs = (self.regs.get(reg::FIFO_DOWNS) >> 4) & 0x07;

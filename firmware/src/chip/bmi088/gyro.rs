@@ -27,7 +27,9 @@
 //! the MSB lock between separate transactions.
 
 use margemu_protocol::regmap::bmi088::convert::gyro_to_raw;
-use margemu_protocol::regmap::bmi088::gyro::{bits, reg, Bandwidth, GyroRange, I2C_ADDRESS};
+use margemu_protocol::regmap::bmi088::gyro::{
+    bits, reg, Bandwidth, GyroRange, DATA_LEN, I2C_ADDRESS,
+};
 use margemu_protocol::regmap::bmi088::Die;
 
 use super::super::spi_phase::{SpiPhase, SpiRegisters};
@@ -124,13 +126,19 @@ impl Bmi088Gyro {
 
     /// Latches `sample` at die time `now_ns` (see the [module docs](self)).
     pub fn latch_at(&mut self, sample: &PhysicalSample, now_ns: u64) {
+        let range = GyroRange::from_reg(self.regs.get(reg::RANGE));
+        let mut data = [0; DATA_LEN];
+        put_le(&mut data, sample.gyr.map(|w| gyro_to_raw(w, range)));
+        self.latch_data(data, now_ns);
+    }
+
+    /// Latches RATE_X..Z as the registers hold them (`data`) at die time `now_ns`, as
+    /// [`Bmi088Gyro::latch_at`] does with the values it converts.
+    pub fn latch_data(&mut self, data: [u8; DATA_LEN], now_ns: u64) {
         self.advance(now_ns);
         if !self.is_normal() {
             return;
         }
-        let range = GyroRange::from_reg(self.regs.get(reg::RANGE));
-        let mut data = [0; 6];
-        put_le(&mut data, sample.gyr.map(|w| gyro_to_raw(w, range)));
         self.drdy_at = Some(self.now_ns);
         self.fifo_push(data);
         if self.spi.is_active() || self.i2c != I2cPort::Idle {

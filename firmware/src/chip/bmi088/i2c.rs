@@ -38,7 +38,8 @@ pub(super) trait I2cRegisters {
 
 fn start(die: &mut impl I2cRegisters, address: u8, read: bool) -> bool {
     if !die.answers(address) {
-        *die.port() = I2cPort::Idle;
+        // A repeated START to another target ends this die's part of the transaction.
+        stop(die);
         return false;
     }
     let pointer = die.pointer();

@@ -20,6 +20,13 @@
 //! modes, the 100-frame FIFO, the data-ready pulse, INT3/INT4. Each module says what it does not
 //! emulate.
 //!
+//! **The served part** ([`Bmi088`], `package.rs`): both dies as one [`Chip`](super::Chip) of
+//! model [`ChipModel::Bmi088`](margemu_protocol::chip::ChipModel::Bmi088), the accelerometer on
+//! the package's own chip select and the gyroscope on the next one
+//! ([`Bmi088::die_spi_target`]), both on I2C; images latch the gyro at the served rate and
+//! the accel at its own ODR. Register file 0 is the accelerometer, file 1 the gyroscope
+//! (`boundary.rs`).
+//!
 //! Driver sequences read (no code taken): PX4 `src/drivers/imu/bosch/bmi088/`
 //! (`BMI088_Accelerometer.cpp`, `BMI088_Gyroscope.cpp`), ArduPilot
 //! `libraries/AP_InertialSensor/AP_InertialSensor_BMI088.cpp`, the Rust `bmi088` crate 0.2.1 and
@@ -51,12 +58,15 @@
 
 pub mod accel;
 pub mod accel_fifo;
+mod boundary;
 pub mod gyro;
 pub mod gyro_fifo;
 mod i2c;
+mod package;
 
 pub use accel::Bmi088Accel;
 pub use gyro::Bmi088Gyro;
+pub use package::{Bmi088, Config};
 
 use margemu_protocol::regmap::bmi088::Die;
 

@@ -220,6 +220,19 @@ impl Odr {
     pub const fn period_ns(self) -> u64 {
         80_000_000 >> (self.0.saturating_sub(5))
     }
+
+    /// The rate, Hz.
+    pub fn hz(self) -> f64 {
+        1e9 / self.period_ns() as f64
+    }
+
+    /// The fastest rate at or below `hz` (within 1e-9 relative); `None` below 12.5 Hz.
+    pub fn at_most_hz(hz: f64) -> Option<Self> {
+        (0x05..=0x0C)
+            .rev()
+            .map(Self)
+            .find(|odr| odr.hz() <= hz * (1.0 + 1e-9))
+    }
 }
 
 /// Whether an ACC_CONF value is valid: acc_bwp 0x8–0xA (OSR4, OSR2, normal) and a listed ODR.
@@ -248,6 +261,11 @@ mod tests {
         assert_eq!(Odr::HZ100.period_ns(), 10_000_000);
         assert_eq!(Odr::HZ1600.period_ns(), 625_000);
         assert_eq!(Odr::from_conf(0x0D), None);
+        assert_eq!(Odr::at_most_hz(2000.0), Some(Odr::HZ1600));
+        assert_eq!(Odr::at_most_hz(1000.0).map(Odr::code), Some(0x0B)); // 800 Hz
+        assert_eq!(Odr::at_most_hz(400.0).map(Odr::hz), Some(400.0));
+        assert_eq!(Odr::at_most_hz(12.5).map(Odr::code), Some(0x05));
+        assert_eq!(Odr::at_most_hz(12.0), None);
         assert!(conf_is_valid(0xA8) && conf_is_valid(0x8C) && conf_is_valid(0x95));
         assert!(!conf_is_valid(0xB8) && !conf_is_valid(0x78) && !conf_is_valid(0xA0));
     }

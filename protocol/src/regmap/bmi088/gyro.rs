@@ -246,6 +246,16 @@ impl Bandwidth {
     pub fn period_ns(self) -> u64 {
         1_000_000_000 / u64::from(self.odr_hz().max(1))
     }
+
+    /// The setting of output rate `hz` (within 1e-9 relative) with the widest filter: 2000 Hz
+    /// (532 Hz filter, the reset value), 1000, 400, 200 (64 Hz) or 100 Hz (32 Hz); `None` for
+    /// any other rate.
+    pub fn widest_at_hz(hz: f64) -> Option<Self> {
+        (0..8u8)
+            .map(Self)
+            .filter(|bw| (f64::from(bw.odr_hz()) - hz).abs() <= 1e-9 * hz)
+            .max_by_key(|bw| bw.filter_hz())
+    }
 }
 
 #[cfg(test)]
@@ -277,5 +287,11 @@ mod tests {
         }
         assert_eq!(Bandwidth::from_reg(0x87).filter_hz(), 32);
         assert_eq!(Bandwidth::from_reg(0x0A).code(), 2);
+        let codes = [2000.0, 1000.0, 400.0, 200.0, 100.0].map(Bandwidth::widest_at_hz);
+        assert_eq!(
+            codes.map(|bw| bw.map(Bandwidth::code)),
+            [0, 2, 3, 6, 7].map(Some)
+        );
+        assert_eq!(Bandwidth::widest_at_hz(800.0), None);
     }
 }

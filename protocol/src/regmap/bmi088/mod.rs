@@ -1,7 +1,8 @@
 //! The Bosch BMI088 inertial measurement unit: two dies in one package, each with its own
 //! register map, chip select (SPI) or I2C address. [`accel`] is the accelerometer die (also
 //! the temperature sensor and the sensor time), [`gyro`] the gyroscope die; [`convert`] turns
-//! physical values into their register values; [`Die`] gives the access rules of either map.
+//! physical values into their register values; [`image`] is the 14-byte register image of one
+//! sample the link carries; [`Die`] gives the access rules of either map.
 //!
 //! Sources ("DS" and "AN" below):
 //! - datasheet BST-BMI088-DS001-14, revision 1.4 (September 2018): section 3 (quick start),
@@ -39,6 +40,7 @@
 pub mod accel;
 pub mod convert;
 pub mod gyro;
+pub mod image;
 
 /// Which die of the package a register belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
