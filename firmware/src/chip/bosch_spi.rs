@@ -147,3 +147,36 @@ impl BoschSpi {
         };
     }
 }
+
+/// Implements [`BoschRegisters`] and [`SpiTarget`](super::SpiTarget) for a chip behind
+/// [`BoschSpi`]: one with the fields `spi: BoschSpi` and `soft_reset_seen: bool` (set when a
+/// soft reset is commanded over SPI) and a method `bus_went_idle(&mut self)` (the transaction
+/// ended: held values released, a waiting sample shown), besides its [`SpiRegisters`].
+macro_rules! bosch_spi_target {
+    ($chip:ty) => {
+        impl $crate::chip::bosch_spi::BoschRegisters for $chip {
+            fn take_soft_reset(&mut self) -> bool {
+                core::mem::take(&mut self.soft_reset_seen)
+            }
+        }
+
+        impl $crate::chip::SpiTarget for $chip {
+            fn select(&mut self) -> u8 {
+                self.spi.select()
+            }
+
+            fn exchange(&mut self, mosi: u8) -> u8 {
+                let mut front = self.spi;
+                let miso = front.exchange(mosi, self);
+                self.spi = front;
+                miso
+            }
+
+            fn deselect(&mut self) {
+                self.spi.deselect();
+                self.bus_went_idle();
+            }
+        }
+    };
+}
+pub(crate) use bosch_spi_target;

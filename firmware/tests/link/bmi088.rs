@@ -6,9 +6,7 @@
 
 use margemu_firmware::chip::{Chip, SpiTarget};
 use margemu_protocol::chip::{ChipSettings, FullScale};
-use margemu_protocol::link::{
-    AddDevice, Bus, Configure, DeviceBus, ErrorCode, Rate, RegisterOverride,
-};
+use margemu_protocol::link::{AddDevice, Bus, Configure, DeviceBus, ErrorCode, Message};
 
 use crate::common::*;
 
@@ -34,15 +32,6 @@ fn bmi_image(i: u64) -> Image {
     Image::from(im)
 }
 
-fn errors(out: &[Out]) -> Vec<(ErrorCode, u32)> {
-    out.iter()
-        .filter_map(|o| match o {
-            Out::Error(e) => Some((e.code, e.detail)),
-            _ => None,
-        })
-        .collect()
-}
-
 fn writes(out: &[Out]) -> Vec<(Bus, u8, u8, u8)> {
     out.iter()
         .filter_map(|o| match o {
@@ -64,19 +53,11 @@ fn a_bmi088_is_configured_on_both_dies_and_serves_every_image_on_two_chip_select
         gyro_dps: 1000.0,
     };
     let settings = ChipSettings::with_full_scale(ChipModel::Bmi088, fs).unwrap();
-    let mut cfg = Configure::new(ChipModel::Bmi088, Rate::hz(2000).unwrap());
+    let cfg = configure_with(&settings, 2000);
     assert_eq!(
         (cfg.who_am_i, cfg.image_len, cfg.i2c_address),
         (0x1E, 14, 0x18)
     );
-    for (file, register, value) in settings.config_writes(2000.0) {
-        let o = RegisterOverride {
-            file,
-            register,
-            value,
-        };
-        cfg.overrides.push(o).unwrap();
-    }
     host.configure(&mut dev, cfg);
     let out = poll(&mut dev, 0);
     assert!(out.iter().all(|o| matches!(o, Out::Credit(_))), "{out:?}");
@@ -149,21 +130,13 @@ fn a_bmi088_in_a_rig_takes_two_chip_selects_and_two_addresses() {
     host.configure(&mut dev, Configure::new(ChipModel::Icm42688p, rate_1khz()));
     let mut bmi = AddDevice::new(ChipModel::Bmi088, DeviceBus::Spi);
     bmi.chip_select = 1;
-    host.send(
-        &mut dev,
-        &margemu_protocol::link::Message::AddDevice(bmi),
-        0,
-    );
+    host.send(&mut dev, &Message::AddDevice(bmi), 0);
     // Chip select 2 is the BMI088's gyro; 3 is free.
     let mut rm = AddDevice::new(ChipModel::Rm3100, DeviceBus::Spi);
     rm.chip_select = 2;
-    host.send(
-        &mut dev,
-        &margemu_protocol::link::Message::AddDevice(rm.clone()),
-        0,
-    );
+    host.send(&mut dev, &Message::AddDevice(rm.clone()), 0);
     rm.chip_select = 3;
-    host.send(&mut dev, &margemu_protocol::link::Message::AddDevice(rm), 0);
+    host.send(&mut dev, &Message::AddDevice(rm), 0);
     let out = poll(&mut dev, 0);
     assert_eq!(errors(&out), [(ErrorCode::RigRefused, 3)], "{out:?}");
     let rig = dev.rig();
@@ -193,20 +166,12 @@ fn a_bmi088_in_a_rig_takes_two_chip_selects_and_two_addresses() {
     host.hello(&mut dev, 2);
     host.configure(&mut dev, Configure::new(ChipModel::Icm42688p, rate_1khz()));
     let bmi = AddDevice::new(ChipModel::Bmi088, DeviceBus::I2c);
-    host.send(
-        &mut dev,
-        &margemu_protocol::link::Message::AddDevice(bmi.clone()),
-        0,
-    );
+    host.send(&mut dev, &Message::AddDevice(bmi.clone()), 0);
     let bmi = AddDevice {
         i2c_address: 0x19,
         ..bmi
     };
-    host.send(
-        &mut dev,
-        &margemu_protocol::link::Message::AddDevice(bmi),
-        0,
-    );
+    host.send(&mut dev, &Message::AddDevice(bmi), 0);
     assert_eq!(errors(&poll(&mut dev, 0)), [(ErrorCode::RigRefused, 2)]);
     let rig = dev.rig_mut();
     for (address, model) in [(0x19, ChipModel::Bmi088), (0x69, ChipModel::Bmi088)] {

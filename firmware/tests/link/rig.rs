@@ -12,15 +12,6 @@ fn add(host: &mut Host, dev: &mut Dev, a: AddDevice) {
     host.send(dev, &Message::AddDevice(a), 0);
 }
 
-fn errors(out: &[Out]) -> Vec<(ErrorCode, u32)> {
-    out.iter()
-        .filter_map(|o| match o {
-            Out::Error(e) => Some((e.code, e.detail)),
-            _ => None,
-        })
-        .collect()
-}
-
 /// An ICM-42688-P rig with an IST8310 on I2C and an MPU-6000 on chip select 1.
 fn rig() -> (Dev, Host) {
     let mut dev = Dev::new();

@@ -327,7 +327,7 @@ impl ChipModel {
                 "the filters' effect on the data (ACC_CONF bwp and GYRO_BANDWIDTH are stored)",
                 "boot, reset and power-mode settling times, write spacing in suspend",
                 "self-test responses, FIFO tags and input pins, external FIFO sync",
-                "a board's second chip select: boards serve device 0's accel die",
+                "a board's second chip select (the Black Pill serves device 0's accel die)",
             ],
             Family::Bmi270 => &[
                 "the filters' effect on the data, pre-filtered FIFO data (settings are stored)",

@@ -34,10 +34,10 @@ use margemu_protocol::regmap::bmi088::convert::{
 };
 use margemu_protocol::regmap::bmi088::Die;
 
-use super::super::bosch_spi::{BoschRegisters, BoschSpi};
+use super::super::bosch_spi::{bosch_spi_target, BoschSpi};
 use super::super::spi_phase::SpiRegisters;
 use super::super::write_log::{Bus, RegisterWrite, WriteLog};
-use super::super::{PhysicalSample, SpiTarget};
+use super::super::PhysicalSample;
 use super::accel_fifo::AccelFifo;
 use super::i2c::{I2cPort, I2cRegisters};
 use super::{pin_level, put_le, Regs, WRITE_LOG_LEN};
@@ -353,29 +353,7 @@ impl SpiRegisters for Bmi088Accel {
     }
 }
 
-impl BoschRegisters for Bmi088Accel {
-    fn take_soft_reset(&mut self) -> bool {
-        core::mem::take(&mut self.soft_reset_seen)
-    }
-}
-
-impl SpiTarget for Bmi088Accel {
-    fn select(&mut self) -> u8 {
-        self.spi.select()
-    }
-
-    fn exchange(&mut self, mosi: u8) -> u8 {
-        let mut front = self.spi;
-        let miso = front.exchange(mosi, self);
-        self.spi = front;
-        miso
-    }
-
-    fn deselect(&mut self) {
-        self.spi.deselect();
-        self.bus_went_idle();
-    }
-}
+bosch_spi_target!(Bmi088Accel);
 
 impl I2cRegisters for Bmi088Accel {
     fn port(&mut self) -> &mut I2cPort {

@@ -20,7 +20,7 @@
 //! modes, the 100-frame FIFO, the data-ready pulse, INT3/INT4. Each module says what it does not
 //! emulate.
 //!
-//! **The served part** ([`Bmi088`], `package.rs`): both dies as one [`Chip`](super::Chip) of
+//! **The served part** ([`Bmi088`], [`package`]): both dies as one [`Chip`](super::Chip) of
 //! model [`ChipModel::Bmi088`](margemu_protocol::chip::ChipModel::Bmi088), the accelerometer on
 //! the package's own chip select and the gyroscope on the next one
 //! ([`Bmi088::die_spi_target`]), both on I2C; images latch the gyro at the served rate and
@@ -62,7 +62,7 @@ mod boundary;
 pub mod gyro;
 pub mod gyro_fifo;
 mod i2c;
-mod package;
+pub mod package;
 
 pub use accel::Bmi088Accel;
 pub use gyro::Bmi088Gyro;
