@@ -27,6 +27,13 @@
 //!     results published);
 //! (8) `rm3100/spi burst` and `rm3100/i2c burst`: the 9 result bytes from 0x24 (SPI: select,
 //!     0x80 | 0x24 + 9 bytes, deselect; I2C: register pointer, repeated START, 9 reads, STOP).
+//! The BMI088's two dies, not yet behind the chip boundary, directly:
+//! (9) `bmi088 latch_at/{accel,gyro}`: a physical sample into each die's registers and FIFO
+//!     (accel ±24 g, 1.6 kHz, FIFO on; gyro ±2000 °/s, 2 kHz, FIFO mode), the FIFOs emptied
+//!     outside the timing;
+//! (10) `bmi088 spi burst`: the accel data (0x80 | 0x12, dummy + 6 bytes), the gyro data
+//!     (0x80 | 0x02 + 6 bytes), and one FIFO frame each (accel 0x80 | 0x26 + dummy + 7 bytes,
+//!     gyro 0x80 | 0x3F + 6 bytes), refilled between timed reads.
 //!
 //! The requirement: well under one byte time of a 20 MHz SPI clock (400 ns) per byte.
 //!
@@ -36,6 +43,7 @@
 #![allow(missing_docs)]
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use margemu_firmware::chip::bmi088::{Bmi088Accel, Bmi088Gyro};
 use margemu_firmware::chip::{
     Chip, EmulatedChip, I2cTarget, Mpu6xxx, PhysicalSample, Rm3100, SpiTarget,
 };
@@ -152,7 +160,8 @@ fn spi_write(chip: &mut EmulatedChip, bytes: &[u8]) {
 
 /// `model` at power-on with its sensors on (MPU family: PWR_MGMT_1 = 0x01, awake on the PLL;
 /// ICM-42688-P: PWR_MGMT0 = 0x0F, gyro and accel low noise; BMI270: the dummy read, a
-/// 328-byte configuration upload, PWR_CTRL = 0x0E; QMC5883L: CONF1 = 0x0D, continuous at
+/// 328-byte configuration upload, PWR_CTRL = 0x0E; BMI088: the accelerometer's dummy read,
+/// ACC_PWR_CONF = 0x00, ACC_PWR_CTRL = 0x04 (the gyro runs from power-on); QMC5883L: CONF1 = 0x0D, continuous at
 /// 200 Hz; IST8310: single measurements, triggered by its reader; RM3100: continuous).
 fn powered(model: ChipModel) -> EmulatedChip {
     let address = model.i2c_addresses()[0];
@@ -169,6 +178,11 @@ fn powered(model: ChipModel) -> EmulatedChip {
             spi_write(&mut chip, &upload);
             spi_write(&mut chip, &[0x59, 0x01]);
             spi_write(&mut chip, &[0x7D, 0x0E]);
+        }
+        Family::Bmi088 => {
+            spi_write(&mut chip, &[0x80, 0x00]);
+            spi_write(&mut chip, &[0x7C, 0x00]);
+            spi_write(&mut chip, &[0x7D, 0x04]);
         }
         Family::Qmc5883l => assert!(chip.write_register(0, 0x09, 0x0D)),
         Family::Ist8310 => {}
@@ -397,5 +411,142 @@ fn rm3100(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, latch, burst, per_chip, rm3100);
+/// Both BMI088 dies configured as PX4 runs them (accel ±24 g at 1.6 kHz with FIFO frames, gyro
+/// ±2000 °/s at 2 kHz in FIFO mode).
+fn bmi088_dies() -> (Bmi088Accel, Bmi088Gyro) {
+    let write = |chip: &mut dyn SpiTarget, bytes: &[u8]| {
+        chip.select();
+        for &b in bytes {
+            chip.exchange(b);
+        }
+        chip.deselect();
+    };
+    let mut accel = Bmi088Accel::new();
+    write(&mut accel, &[0x80, 0x00]); // dummy read: SPI mode
+    for bytes in [
+        [0x7C, 0x00],
+        [0x7D, 0x04],
+        [0x40, 0xAC],
+        [0x41, 0x03],
+        [0x49, 0x50],
+    ] {
+        write(&mut accel, &bytes);
+    }
+    let mut gyro = Bmi088Gyro::new();
+    write(&mut gyro, &[0x3E, 0x40]);
+    (accel, gyro)
+}
+
+fn bmi088(c: &mut Criterion) {
+    let s = sample();
+    let (mut accel, mut gyro) = bmi088_dies();
+    let mut group = c.benchmark_group("bmi088 latch_at");
+    let mut now = 0u64;
+    group.bench_function("accel", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                now += 625_000;
+                let t = Instant::now();
+                accel.latch_at(black_box(&s), now);
+                total += t.elapsed();
+                accel.select();
+                accel.exchange(0x7E);
+                accel.exchange(0xB0); // FIFO reset, untimed
+                accel.deselect();
+            }
+            total
+        })
+    });
+    group.bench_function("gyro", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                now += 500_000;
+                let t = Instant::now();
+                gyro.latch_at(black_box(&s), now);
+                total += t.elapsed();
+                gyro.select();
+                gyro.exchange(0x3E);
+                gyro.exchange(0x40); // FIFO cleared, untimed
+                gyro.deselect();
+            }
+            total
+        })
+    });
+    group.finish();
+
+    let mut group = c.benchmark_group("bmi088 spi burst");
+    let (mut accel, mut gyro) = bmi088_dies();
+    accel.latch_at(&s, 625_000);
+    gyro.latch_at(&s, 500_000);
+    let time_reads = |chip: &mut dyn SpiTarget, mosi: &[u8], iters: u64| {
+        let t = Instant::now();
+        for _ in 0..iters {
+            let mut acc = chip.select();
+            for &byte in black_box(mosi) {
+                acc ^= chip.exchange(byte);
+            }
+            chip.deselect();
+            black_box(acc);
+        }
+        t.elapsed()
+    };
+    let mut mosi = [0u8; 8];
+    mosi[0] = 0x80 | 0x12;
+    group.throughput(Throughput::Bytes(8));
+    group.bench_function("accel 0x12 + dummy + 6 bytes", |b| {
+        b.iter_custom(|iters| time_reads(&mut accel, &mosi, iters))
+    });
+    let mut mosi = [0u8; 7];
+    mosi[0] = 0x80 | 0x02;
+    group.throughput(Throughput::Bytes(7));
+    group.bench_function("gyro 0x02 + 6 bytes", |b| {
+        b.iter_custom(|iters| time_reads(&mut gyro, &mosi, iters))
+    });
+    // One FIFO frame per timed read, latched before each chunk (fewer than either FIFO holds).
+    const CHUNK: u64 = 64;
+    let (mut accel, mut gyro) = bmi088_dies();
+    let mut mosi = [0u8; 9];
+    mosi[0] = 0x80 | 0x26;
+    group.throughput(Throughput::Bytes(9));
+    group.bench_function("accel FIFO 0x26 + dummy + 7-byte frame", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            let mut left = iters;
+            while left > 0 {
+                let n = left.min(CHUNK);
+                for _ in 0..n {
+                    let t = accel.now_ns() + 625_000;
+                    accel.latch_at(&s, t);
+                }
+                total += time_reads(&mut accel, &mosi, n);
+                left -= n;
+            }
+            total
+        })
+    });
+    let mut mosi = [0u8; 7];
+    mosi[0] = 0x80 | 0x3F;
+    group.throughput(Throughput::Bytes(7));
+    group.bench_function("gyro FIFO 0x3F + 6-byte frame", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            let mut left = iters;
+            while left > 0 {
+                let n = left.min(CHUNK);
+                for _ in 0..n {
+                    let t = gyro.now_ns() + 500_000;
+                    gyro.latch_at(&s, t);
+                }
+                total += time_reads(&mut gyro, &mosi, n);
+                left -= n;
+            }
+            total
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, latch, burst, per_chip, rm3100, bmi088);
 criterion_main!(benches);

@@ -163,6 +163,7 @@ fn chips_lists_every_model_with_its_facts() {
         "ICM-20602",
         "ICM-42688-P",
         "BMI270",
+        "BMI088",
     ] {
         assert!(
             text.contains(&format!("{part} ([chip] model")),
@@ -186,6 +187,19 @@ fn chips_lists_every_model_with_its_facts() {
         "accel ranges: ± 2, 4, 8, 16 g (power-on ±8 g)",
         "gyro ranges:  ± 125, 250, 500, 1000, 2000 °/s (power-on ±2000 °/s)",
         "output rates: 3200 Hz, 1600 Hz, 800 Hz, 400 Hz, 200 Hz, 100 Hz, 50 Hz, 25 Hz (the gyro's",
+        "image:        14 bytes",
+    ] {
+        assert!(text.contains(line), "{line}: {text}");
+    }
+    let out = margemu(&["chips", "bmi088"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for line in [
+        "ACC_CHIP_ID:  0x1e",
+        "buses:        SPI on 2 chip selects (accel die, then gyro die), I2C at 0x18, 0x19 \
+         (accel die; gyro die at 0x68, 0x69 alike)",
+        "accel ranges: ± 3, 6, 12, 24 g (power-on ±6 g)",
+        "gyro ranges:  ± 125, 250, 500, 1000, 2000 °/s (power-on ±2000 °/s)",
+        "output rates: 2000 Hz, 1000 Hz, 400 Hz, 200 Hz, 100 Hz (the gyro's",
         "image:        14 bytes",
     ] {
         assert!(text.contains(line), "{line}: {text}");

@@ -167,7 +167,7 @@ fn chip_table_errors_are_located() {
     assert_error(
         &chip("model = \"bmi999\"\n"),
         "5:9",
-        "no chip model \"bmi999\"; margemu emulates mpu9250, mpu6500, mpu6000, icm20602, icm42688p, bmi270",
+        "no chip model \"bmi999\"; margemu emulates mpu9250, mpu6500, mpu6000, icm20602, icm42688p, bmi270, ist8310, qmc5883l, rm3100, bmi088",
     );
     assert_error(&chip("bus = \"can\"\n"), "5:7", "unknown variant `can`");
     assert_error(
@@ -369,6 +369,64 @@ fn rig_errors_are_located() {
         "2:8",
         "250 Hz is not an output rate of the ICM-42688-P",
     );
+}
+
+/// A BMI088 takes two chip selects (its `chip_select` and the next one, the gyro die's) and two
+/// I2C addresses (its accel's, and 0x68 or 0x69 for its gyro): clashes with either are refused
+/// where they are, naming the die.
+#[test]
+fn bmi088_rig_errors_are_located() {
+    let dev = |body: &str| format!("\n[[device]]\n{body}");
+    let bmi = dev("name = \"bmi\"\nmodel = \"bmi088\"\n");
+    assert_error(
+        &format!("{BASE}{}", dev("model = \"bmi088\"\nchip_select = 3\n")),
+        "7:15",
+        "the BMI088 takes chip select 3 and the next one (its gyroscope die), but a board has \
+         chip selects 0..=3: use one of 0..=2",
+    );
+    assert_error(
+        &format!(
+            "{BASE}{bmi}{}",
+            dev("model = \"mpu6000\"\nchip_select = 1\n")
+        ),
+        "11:15",
+        "chip select 1 is device `bmi`'s already: the BMI088's gyroscope die (chip_select + 1)",
+    );
+    assert_error(
+        &format!(
+            "{BASE}{}{}",
+            dev("model = \"mpu6000\"\nchip_select = 2\n"),
+            dev("model = \"bmi088\"\nchip_select = 1\n")
+        ),
+        "11:15",
+        "chip select 2, the BMI088's gyroscope die (chip_select + 1), is device `mpu6000`'s already",
+    );
+    assert_error(
+        &format!(
+            "{BASE}{}{}",
+            dev("model = \"icm42688p\"\nbus = \"i2c\"\n"),
+            dev("model = \"bmi088\"\nbus = \"i2c\"\naddress = 0x18\n")
+        ),
+        "12:11",
+        "device `icm42688p` answers I2C at 0x68 already",
+    );
+    // The issue's rig: accel on 1, gyro on 2, an ICM-42688-P on 0, an RM3100 on 3; and a
+    // BMI088 on I2C beside an ICM-42688-P at 0x68 once strapped to 0x19 (gyro 0x69).
+    let text = format!(
+        "{BASE}{}{}{}",
+        dev("model = \"icm42688p\"\n"),
+        dev("model = \"bmi088\"\nchip_select = 1\naccel_range = 24\n"),
+        dev("model = \"rm3100\"\nchip_select = 3\n")
+    );
+    let scene = Scene::parse_str(&text, Path::new("rig.toml")).unwrap();
+    let selects: Vec<u8> = scene.devices().iter().map(|d| d.chip.chip_select).collect();
+    assert_eq!(selects, [0, 1, 3]);
+    let text = format!(
+        "{BASE}{}{}",
+        dev("model = \"icm42688p\"\nbus = \"i2c\"\n"),
+        dev("model = \"bmi088\"\nbus = \"i2c\"\naddress = 0x19\n")
+    );
+    assert!(Scene::parse_str(&text, Path::new("rig.toml")).is_ok());
 }
 
 #[test]

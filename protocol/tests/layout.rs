@@ -53,7 +53,7 @@ fn chips_are_a_set_of_model_codes() {
     let all = ChipModel::ALL
         .into_iter()
         .fold(Chips::EMPTY, |c, m| c | Chips::of(m));
-    assert_eq!(all, Chips(0x1FF));
+    assert_eq!(all, Chips(0x3FF));
     assert!(all.models().eq(ChipModel::ALL));
     // Unknown bits (a newer device's models) are kept on the wire and skipped by `models`.
     let newer = Chips(0x8000_0000 | Chips::of(ChipModel::Icm42688p).0);
@@ -335,7 +335,8 @@ fn configure_names_the_chip() {
             (5, 14),
             (6, 6),
             (7, 6),
-            (8, 9)
+            (8, 9),
+            (9, 14)
         ]
     );
     // Identity, image length and address are carried as they are (the device judges them);
@@ -354,7 +355,7 @@ fn configure_names_the_chip() {
     assert_eq!(b[21..], [1, 4, 0x7B, 0x02]);
     parses_back(Kind::Configure, &b, &m);
     // An unknown chip code is refused.
-    for code in [9, 0x80, 0xFF] {
+    for code in [10, 0x80, 0xFF] {
         let mut bad = b.clone();
         bad[0] = code;
         assert_eq!(
@@ -494,7 +495,7 @@ fn add_device_carries_the_rig_device_and_refuses_what_it_cannot() {
         Err(Error::InvalidValue)
     );
     assert_eq!(
-        Message::parse(0x05, &[9, 0x24, 14, 0, 0x68, 0, 0]),
+        Message::parse(0x05, &[10, 0x24, 14, 0, 0x68, 0, 0]),
         Err(Error::UnknownChip)
     );
     let nine = [&[8u8, 0x22, 9, 1, 0x20, 0, 9][..], &[0u8; 27]].concat();

@@ -1,6 +1,6 @@
-//! One chip model on the QEMU board in both source modes (`qemu_icm42688p`, `qemu_bmi270`):
-//! the board, configured by a scene's `[chip]`, must serve every image equal to the host's
-//! prediction byte for byte (the CRC-32C of each image in its Served reports).
+//! One chip model on the QEMU board in both source modes (`qemu_icm42688p`, `qemu_bmi270`,
+//! `qemu_bmi088`): the board, configured by a scene's `[chip]`, must serve every image equal to
+//! the host's prediction byte for byte (the CRC-32C of each image in its Served reports).
 //!
 //! - [`image_mode`], as `qemu_stream` does for the MPU-9250: a `margemu::stream::Session`
 //!   streams the host's images at [`ChipCase::image_rate_hz`]; the device latches them into its
@@ -15,6 +15,7 @@
 //! paper's noise, biases, hard iron, a warming die) with the case's `[chip]`.
 
 use std::path::Path;
+use std::sync::{Mutex, MutexGuard};
 
 use margemu::scene::Scene;
 use margemu::stream::predict_images;
@@ -22,6 +23,7 @@ use margemu_protocol::chip::{ChipModel, FullScale};
 
 use crate::model_source::ModelStream;
 use crate::motion_scene_text;
+use crate::qemu;
 use crate::qemu_session::{
     build_board, image_session, model_script, predicted_crcs, run_images, run_model, scratch,
 };
@@ -61,8 +63,24 @@ impl ChipCase {
     }
 }
 
-/// Source mode (a) on the board (see the module docs).
+/// One QEMU at a time in a test process: the machine's UART is slow enough alone.
+static QEMU_LOCK: Mutex<()> = Mutex::new(());
+
+/// The QEMU lock for the case's `mode` run; `None` (and a message) where the prerequisites are
+/// missing ([`qemu::prerequisites_or_skip`]: a failure under `CI=true`).
+fn one_qemu(case: &ChipCase, mode: &str) -> Option<MutexGuard<'static, ()>> {
+    if !qemu::prerequisites_or_skip(&case.label(mode)) {
+        return None;
+    }
+    Some(QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// Source mode (a) on the board (see the module docs); skipped without QEMU or a cross
+/// toolchain.
 pub fn image_mode(case: &ChipCase, seed: u64) {
+    let Some(_one_qemu) = one_qemu(case, "images") else {
+        return;
+    };
     let (elf, build) = build_board();
     let (rate, len) = (case.image_rate_hz, case.model.image_len());
     let scene = case.scene(rate, seed);
@@ -89,8 +107,12 @@ pub fn image_mode(case: &ChipCase, seed: u64) {
     );
 }
 
-/// Source mode (b) on the board (see the module docs).
+/// Source mode (b) on the board (see the module docs); skipped without QEMU or a cross
+/// toolchain.
 pub fn model_mode(case: &ChipCase, seed: u64) {
+    let Some(_one_qemu) = one_qemu(case, "model") else {
+        return;
+    };
     let (elf, build) = build_board();
     let (rate, len, decimation) = (case.model_rate_hz, case.model.image_len(), case.decimation);
     let scene = case.scene(rate, seed);

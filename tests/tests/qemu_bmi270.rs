@@ -18,10 +18,7 @@
 //! Skipped, with a message, where `qemu-system-arm` or a cross toolchain is missing; under
 //! `CI=true` that is a failure instead.
 
-use std::sync::Mutex;
-
 use margemu_protocol::chip::{ChipModel, FullScale};
-use margemu_tests::qemu;
 use margemu_tests::qemu_chip::{image_mode, model_mode, ChipCase};
 
 /// The BMI270 on I2C at 0x69, ±4 g and ±500 °/s, upside down; 2 s scenes.
@@ -46,23 +43,12 @@ rotation = [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]
     seconds: 2.0,
 };
 
-/// One QEMU at a time: the machine's UART is slow enough alone.
-static QEMU_LOCK: Mutex<()> = Mutex::new(());
-
 #[test]
 fn bmi270_image_mode_serves_the_hosts_images_byte_for_byte() {
-    if !qemu::prerequisites_or_skip("qemu_bmi270 (images)") {
-        return;
-    }
-    let _one_qemu = QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     image_mode(&CASE, 27);
 }
 
 #[test]
 fn bmi270_model_mode_serves_the_hosts_prediction_bit_for_bit() {
-    if !qemu::prerequisites_or_skip("qemu_bmi270 (model)") {
-        return;
-    }
-    let _one_qemu = QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     model_mode(&CASE, 31);
 }

@@ -18,10 +18,7 @@
 //! Skipped, with a message, where `qemu-system-arm` or a cross toolchain is missing; under
 //! `CI=true` that is a failure instead.
 
-use std::sync::Mutex;
-
 use margemu_protocol::chip::{ChipModel, FullScale};
-use margemu_tests::qemu;
 use margemu_tests::qemu_chip::{image_mode, model_mode, ChipCase};
 
 /// The ICM-42688-P on SPI, not at its power-on full scales, turned 90° about z; 2 s scenes.
@@ -45,23 +42,12 @@ rotation = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
     seconds: 2.0,
 };
 
-/// One QEMU at a time: the machine's UART is slow enough alone.
-static QEMU_LOCK: Mutex<()> = Mutex::new(());
-
 #[test]
 fn icm42688p_image_mode_serves_the_hosts_images_byte_for_byte() {
-    if !qemu::prerequisites_or_skip("qemu_icm42688p (images)") {
-        return;
-    }
-    let _one_qemu = QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     image_mode(&CASE, 13);
 }
 
 #[test]
 fn icm42688p_model_mode_serves_the_hosts_prediction_bit_for_bit() {
-    if !qemu::prerequisites_or_skip("qemu_icm42688p (model)") {
-        return;
-    }
-    let _one_qemu = QEMU_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     model_mode(&CASE, 17);
 }

@@ -19,6 +19,7 @@
 
 use margemu_protocol::chip::{ChipModel, ChipSettings, PhysicalSample};
 
+use super::bmi088::{self, Bmi088};
 use super::bmi270::{self, Bmi270};
 use super::icm42688p::{self, Icm42688p};
 use super::mpu6xxx::{self, Mpu6xxx, Variant};
@@ -83,7 +84,8 @@ pub trait Chip: SpiTarget + I2cTarget {
         }
     }
     /// The byte an SPI read clocks out before the addressed register's value, if reads have
-    /// one now (the BMI270's dummy byte, in SPI mode); [`Chip::spi_read_burst`] includes it.
+    /// one now (the BMI270's and the BMI088 accelerometer's dummy byte, in SPI mode);
+    /// [`Chip::spi_read_burst`] includes it.
     /// The default: none.
     fn spi_read_dummy(&self) -> Option<u8> {
         None
@@ -121,6 +123,8 @@ pub enum EmulatedChip {
     Icm42688p(Icm42688p),
     /// The Bosch BMI270.
     Bmi270(Bmi270),
+    /// The Bosch BMI088 (both dies).
+    Bmi088(Bmi088),
     /// The iSentek IST8310 magnetometer.
     Ist8310(Ist8310),
     /// The QST QMC5883L magnetometer.
@@ -157,6 +161,9 @@ impl EmulatedChip {
                     sdo: ad0,
                 })))
             }
+            ChipModel::Bmi088 => {
+                return Some(Self::Bmi088(Bmi088::new(bmi088::Config { sdo: ad0 })))
+            }
             ChipModel::Ist8310 => return Some(Self::Ist8310(Ist8310::with_address(i2c_address))),
             ChipModel::Qmc5883l => {
                 return Some(Self::Qmc5883l(Qmc5883l::with_address(i2c_address)))
@@ -185,11 +192,26 @@ impl EmulatedChip {
                 m,
                 ChipModel::Icm42688p
                     | ChipModel::Bmi270
+                    | ChipModel::Bmi088
                     | ChipModel::Ist8310
                     | ChipModel::Qmc5883l
                     | ChipModel::Rm3100
             ) || Variant::for_model(*m, m.who_am_i()).is_some()
         })
+    }
+}
+
+impl EmulatedChip {
+    /// The SPI target on the `die`-th chip select the chip takes
+    /// ([`ChipModel::spi_selects`]): die 0 is the chip itself (its own [`SpiTarget`]; the
+    /// BMI088's accelerometer die), die 1 the BMI088's gyroscope die; `None` past the chip's
+    /// selects.
+    pub fn die_spi_target(&mut self, die: u8) -> Option<&mut dyn SpiTarget> {
+        match (self, die) {
+            (Self::Bmi088(chip), _) => chip.die_spi_target(die),
+            (chip, 0) => Some(chip),
+            _ => None,
+        }
     }
 }
 
@@ -200,6 +222,7 @@ macro_rules! each_chip {
             EmulatedChip::Mpu6xxx($chip) => $call,
             EmulatedChip::Icm42688p($chip) => $call,
             EmulatedChip::Bmi270($chip) => $call,
+            EmulatedChip::Bmi088($chip) => $call,
             EmulatedChip::Ist8310($chip) => $call,
             EmulatedChip::Qmc5883l($chip) => $call,
             EmulatedChip::Rm3100($chip) => $call,
@@ -323,8 +346,8 @@ mod tests {
                 }
             }
             let fs = FullScale {
-                accel_g: 16.0,
-                gyro_dps: 2000.0,
+                accel_g: ChipSettings::accel_ranges_g(model).last().unwrap_or(0.0),
+                gyro_dps: ChipSettings::gyro_ranges_dps(model).last().unwrap_or(0.0),
             };
             let want = match ChipSettings::mag_ranges_gauss(model).last() {
                 Some(&gauss) => ChipSettings::power_on(model).with_mag_range(gauss).unwrap(),

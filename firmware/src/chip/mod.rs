@@ -29,6 +29,9 @@
 //! - [`Bmi270`]: the Bosch BMI270 (SPI with its dummy byte and I2C-to-SPI switch, I2C, the
 //!   configuration upload, data registers at the sensors' own rates, sensor time, the FIFO,
 //!   INT1/INT2 data ready);
+//! - [`Bmi088`]: the Bosch BMI088, its two dies ([`bmi088::Bmi088Accel`],
+//!   [`bmi088::Bmi088Gyro`]) each on its own chip select (or I2C address), each with its FIFO,
+//!   behind one [`Chip`] (the accelerometer's SPI front end shared with the BMI270);
 //! - [`Ist8310`]: the iSentek IST8310 standalone magnetometer (I2C only);
 //! - [`Qmc5883l`]: the QST QMC5883L standalone magnetometer (I2C only); both share their
 //!   [`Chip`] boundary ([`magnetometer`]) and I2C front end ([`pointer_i2c`]).
@@ -37,7 +40,9 @@
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
 
 mod ak8963;
+pub mod bmi088;
 pub mod bmi270;
+mod bosch_spi;
 mod emulated;
 mod i2c_pointer;
 pub mod icm42688p;
@@ -48,9 +53,11 @@ pub mod pointer_i2c;
 pub mod qmc5883l;
 pub mod rm3100;
 mod spi_phase;
+mod tick;
 mod write_log;
 
 pub use ak8963::{Ak8963, MagSource};
+pub use bmi088::Bmi088;
 pub use bmi270::Bmi270;
 pub use emulated::{spi_read_burst_on_copy, Chip, EmulatedChip};
 pub use icm42688p::Icm42688p;

@@ -3,14 +3,22 @@
 //!
 //! A rig's image is every device's image in device order, back to back; [`Rig::latch_image_at`]
 //! hands each chip its slice at the same instant. Register writes are drained from every chip in
-//! device order; on the wire an SPI write carries its device's chip select as its address
-//! (device 0: 0), an I2C write the address written to.
+//! device order; on the wire an SPI write carries its chip select as its address (device 0: 0),
+//! an I2C write the address written to.
+//!
+//! **Chip selects.** A device on chip select `c` takes [`ChipModel::spi_selects`] of them from
+//! `c` on: the BMI088's accelerometer die is on `c`, its gyroscope die on `c + 1` (device 0 on
+//! 0 and 1). [`Rig::spi_device`] says which device and die a chip select reaches and
+//! [`Rig::spi_target`] hands out that die; a write to the BMI088's gyroscope over SPI carries
+//! `c + 1`. On I2C such a device answers both dies' addresses
+//! ([`ChipModel::second_die_i2c_address`]).
 //!
 //! Refusals of an AddDevice ([`RigError`]): the rig is full, the chip model, identity, image
 //! length or address is not one this firmware emulates (as for Configure), an override the chip
-//! has no register file for, an I2C address another device answers, a chip select another SPI
-//! device of the added ones uses (device 0 is on chip select 0 when on SPI), or a rig image that
-//! would exceed [`MAX_IMAGE_LEN`] bytes.
+//! has no register file for, an I2C address another device answers (either die's), a chip
+//! select another SPI device of the added ones takes (device 0 is on chip select 0 when on SPI,
+//! and an added device on one of its selects wins), or a rig image that would exceed
+//! [`MAX_IMAGE_LEN`] bytes.
 //!
 //! ```
 //! use margemu_firmware::chip::{Chip, EmulatedChip};
@@ -23,10 +31,10 @@
 //! assert!(rig.add(&AddDevice::new(ChipModel::Ist8310, DeviceBus::I2c)).is_err()); // 0x0E taken
 //! ```
 
-use margemu_protocol::chip::MAX_IMAGE_LEN;
+use margemu_protocol::chip::{ChipModel, MAX_IMAGE_LEN};
 use margemu_protocol::link::{AddDevice, DeviceBus, ErrorCode, MAX_DEVICES};
 
-use crate::chip::{Chip, EmulatedChip, RegisterWrite};
+use crate::chip::{Chip, EmulatedChip, RegisterWrite, SpiTarget};
 
 /// One chip of a rig and its wiring.
 #[derive(Clone, Debug)]
@@ -35,8 +43,27 @@ pub struct RigDevice {
     pub chip: EmulatedChip,
     /// Its bus.
     pub bus: DeviceBus,
-    /// SPI: its chip select.
+    /// SPI: its (first) chip select.
     pub chip_select: u8,
+}
+
+impl RigDevice {
+    /// On SPI, the die chip select `cs` reaches (0 on its first select).
+    fn die_on(&self, cs: u8) -> Option<u8> {
+        let die = cs.checked_sub(self.chip_select)?;
+        (self.bus == DeviceBus::Spi && die < self.chip.model().spi_selects()).then_some(die)
+    }
+}
+
+/// The 7-bit I2C addresses a chip of `model` strapped to `address` answers (both dies').
+fn die_addresses(model: ChipModel, address: u8) -> [Option<u8>; 2] {
+    [Some(address), model.second_die_i2c_address(address)]
+}
+
+/// Whether the chip selects `first .. first + n` and `other .. other + m` overlap.
+fn selects_overlap(first: u8, n: u8, other: u8, m: u8) -> bool {
+    let (a, b) = (u16::from(first), u16::from(other));
+    a < b + u16::from(m) && b < a + u16::from(n)
 }
 
 /// Why an [`AddDevice`] was refused: the Error code and its detail.
@@ -88,13 +115,19 @@ impl Rig {
         }
         let mut chip =
             EmulatedChip::new(add.chip, add.who_am_i, add.i2c_address).ok_or(unsupported)?;
-        let taken_address = self.chips().any(|c| c.i2c_address() == add.i2c_address);
+        let mine = die_addresses(add.chip, add.i2c_address);
+        let taken_address = self.chips().any(|c| {
+            let theirs = die_addresses(c.model(), c.i2c_address());
+            mine.iter().flatten().any(|a| theirs.contains(&Some(*a)))
+        });
         if add.bus == DeviceBus::I2c && taken_address {
             return Err(RigError::rig(2));
         }
-        let taken_select = self
-            .added()
-            .any(|d| d.bus == DeviceBus::Spi && d.chip_select == add.chip_select);
+        let n = add.chip.spi_selects();
+        let taken_select = self.added().any(|d| {
+            let m = d.chip.model().spi_selects();
+            d.bus == DeviceBus::Spi && selects_overlap(add.chip_select, n, d.chip_select, m)
+        });
         if add.bus == DeviceBus::Spi && taken_select {
             return Err(RigError::rig(3));
         }
@@ -180,17 +213,21 @@ impl Rig {
             .find(|c| c.i2c_addresses_now().contains(&Some(address)))
     }
 
-    /// The chip on SPI chip select `cs`: an added SPI device on it, else device 0 on 0.
-    pub fn spi_target(&mut self, cs: u8) -> Option<&mut EmulatedChip> {
+    /// The device (its index, device 0 first) and die (0 on the device's first select) on SPI
+    /// chip select `cs`: an added SPI device taking it, else device 0 on its own selects.
+    pub fn spi_device(&self, cs: u8) -> Option<(usize, u8)> {
         let added = self
-            .added
-            .iter()
-            .flatten()
-            .position(|d| d.bus == DeviceBus::Spi && d.chip_select == cs);
-        match added {
-            Some(i) => self.added.iter_mut().flatten().nth(i).map(|d| &mut d.chip),
-            None => (cs == 0).then_some(&mut self.primary),
-        }
+            .added()
+            .enumerate()
+            .find_map(|(i, d)| Some((i + 1, d.die_on(cs)?)));
+        added.or_else(|| (cs < self.primary.model().spi_selects()).then_some((0, cs)))
+    }
+
+    /// The SPI target on chip select `cs` ([`Rig::spi_device`]): a chip, or the BMI088's
+    /// gyroscope die on its device's second select.
+    pub fn spi_target(&mut self, cs: u8) -> Option<&mut dyn SpiTarget> {
+        let (device, die) = self.spi_device(cs)?;
+        self.chip_mut(device)?.die_spi_target(die)
     }
 
     /// Latches the rig image `image` at `now_ns`: each device its slice, in order. An image of
@@ -214,15 +251,16 @@ impl Rig {
         }
     }
 
-    /// The oldest register write not yet taken, device by device, with the chip select its
-    /// device is on (0 for device 0 and I2C devices).
+    /// The oldest register write not yet taken, device by device, with the chip select of the
+    /// die written to (device 0 on 0, a BMI088's gyroscope on its device's select + 1; the
+    /// device's select for I2C writes, 0 for device 0's).
     pub fn pop_write(&mut self) -> Option<(RegisterWrite, u8)> {
         if let Some(w) = self.primary.pop_write() {
-            return Some((w, 0));
+            return Some((w, die_of(&self.primary, &w)));
         }
         self.added.iter_mut().flatten().find_map(|d| {
             let w = d.chip.pop_write()?;
-            Some((w, d.chip_select))
+            Some((w, d.chip_select.wrapping_add(die_of(&d.chip, &w))))
         })
     }
 
@@ -231,4 +269,10 @@ impl Rig {
         self.chips()
             .fold(0u32, |n, c| n.wrapping_add(c.writes_dropped()))
     }
+}
+
+/// Which die of `chip` a write went to: 1 for the second die's address, else 0.
+fn die_of(chip: &EmulatedChip, w: &RegisterWrite) -> u8 {
+    let second = chip.model().second_die_i2c_address(chip.i2c_address());
+    u8::from(second == Some(w.device))
 }

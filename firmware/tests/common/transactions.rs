@@ -8,7 +8,7 @@
 use margemu_firmware::chip::{I2cTarget, SpiTarget};
 
 /// One SPI transaction: MOSI bytes in, MISO bytes out, aligned byte for byte.
-pub fn spi(chip: &mut impl SpiTarget, mosi: &[u8]) -> Vec<u8> {
+pub fn spi(chip: &mut (impl SpiTarget + ?Sized), mosi: &[u8]) -> Vec<u8> {
     let mut miso = vec![chip.select()];
     for (i, &byte) in mosi.iter().enumerate() {
         let next = chip.exchange(byte);
@@ -22,14 +22,14 @@ pub fn spi(chip: &mut impl SpiTarget, mosi: &[u8]) -> Vec<u8> {
 }
 
 /// Reads `n` registers from `addr` over SPI.
-pub fn spi_read(chip: &mut impl SpiTarget, addr: u8, n: usize) -> Vec<u8> {
+pub fn spi_read(chip: &mut (impl SpiTarget + ?Sized), addr: u8, n: usize) -> Vec<u8> {
     let mut mosi = vec![0x80 | addr];
     mosi.resize(n + 1, 0x00);
     spi(chip, &mosi)[1..].to_vec()
 }
 
 /// Writes `values` from `addr` on over SPI.
-pub fn spi_write(chip: &mut impl SpiTarget, addr: u8, values: &[u8]) {
+pub fn spi_write(chip: &mut (impl SpiTarget + ?Sized), addr: u8, values: &[u8]) {
     let mut mosi = vec![addr];
     mosi.extend_from_slice(values);
     assert_eq!(

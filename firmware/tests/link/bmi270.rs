@@ -5,7 +5,7 @@
 
 use margemu_firmware::chip::SpiTarget;
 use margemu_protocol::chip::{ChipSettings, FullScale};
-use margemu_protocol::link::{Bus, Configure, Rate, RegisterOverride};
+use margemu_protocol::link::Bus;
 
 use crate::common::*;
 
@@ -42,19 +42,11 @@ fn a_bmi270_is_configured_brought_up_by_its_driver_and_serves_every_image() {
         gyro_dps: 2000.0,
     };
     let settings = ChipSettings::with_full_scale(ChipModel::Bmi270, fs).unwrap();
-    let mut cfg = Configure::new(ChipModel::Bmi270, Rate::hz(1600).unwrap());
+    let cfg = configure_with(&settings, 1600);
     assert_eq!(
         (cfg.who_am_i, cfg.image_len, cfg.i2c_address),
         (0x24, 14, 0x68)
     );
-    for (file, register, value) in settings.config_writes(1600.0) {
-        let o = RegisterOverride {
-            file,
-            register,
-            value,
-        };
-        cfg.overrides.push(o).unwrap();
-    }
     host.configure(&mut dev, cfg);
     let out = poll(&mut dev, 0);
     assert!(out.iter().all(|o| matches!(o, Out::Credit(_))), "{out:?}");

@@ -4,11 +4,12 @@ pub use margemu_firmware::chip::EmulatedChip;
 use margemu_firmware::chip::SpiTarget;
 use margemu_firmware::link::Device;
 pub use margemu_protocol::chip::ChipModel;
+use margemu_protocol::chip::ChipSettings;
 pub use margemu_protocol::link::Image;
 use margemu_protocol::link::{
-    Accumulator, Configure, Credit, Encoder, ErrorReport, FeedResult, FrameRepr, HelloAck,
-    ImageBatch, Message, Rate, RegisterWrite, ResetCause, ServedSample, Start, Telemetry,
-    MAX_WIRE_LEN,
+    Accumulator, Configure, Credit, Encoder, ErrorCode, ErrorReport, FeedResult, FrameRepr,
+    HelloAck, ImageBatch, Message, Rate, RegisterOverride, RegisterWrite, ResetCause, ServedSample,
+    Start, Telemetry, MAX_WIRE_LEN,
 };
 use margemu_protocol::PROTOCOL_VERSION;
 
@@ -214,4 +215,28 @@ pub fn configured() -> (Dev, Host) {
     host.configure(&mut dev, Configure::new(ChipModel::Mpu9250, rate_1khz()));
     poll(&mut dev, 0);
     (dev, host)
+}
+
+/// The `(code, detail)` of every Error in `out`.
+pub fn errors(out: &[Out]) -> Vec<(ErrorCode, u32)> {
+    out.iter()
+        .filter_map(|o| match o {
+            Out::Error(e) => Some((e.code, e.detail)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The Configure of `settings`' model at `rate_hz` with its `config_writes` as overrides.
+pub fn configure_with(settings: &ChipSettings, rate_hz: u32) -> Configure {
+    let mut cfg = Configure::new(settings.model, Rate::hz(rate_hz).unwrap());
+    for (file, register, value) in settings.config_writes(f64::from(rate_hz)) {
+        let o = RegisterOverride {
+            file,
+            register,
+            value,
+        };
+        cfg.overrides.push(o).unwrap();
+    }
+    cfg
 }

@@ -12,15 +12,6 @@ fn add(host: &mut Host, dev: &mut Dev, a: AddDevice) {
     host.send(dev, &Message::AddDevice(a), 0);
 }
 
-fn errors(out: &[Out]) -> Vec<(ErrorCode, u32)> {
-    out.iter()
-        .filter_map(|o| match o {
-            Out::Error(e) => Some((e.code, e.detail)),
-            _ => None,
-        })
-        .collect()
-}
-
 /// An ICM-42688-P rig with an IST8310 on I2C and an MPU-6000 on chip select 1.
 fn rig() -> (Dev, Host) {
     let mut dev = Dev::new();
@@ -91,10 +82,11 @@ fn a_rig_image_latches_every_device_at_once() {
     let data: Vec<u8> = (0..6).map(|_| mag.read()).collect();
     mag.stop();
     assert_eq!(data, (32..38).collect::<Vec<u8>>());
-    assert!(dev
-        .rig_mut()
-        .spi_target(1)
-        .is_some_and(|c| c.model() == ChipModel::Mpu6000));
+    assert_eq!(dev.rig().spi_device(1), Some((2, 0))); // the MPU-6000
+    let mpu = dev.rig_mut().spi_target(1).unwrap();
+    mpu.select();
+    assert_eq!(mpu.exchange(0x80 | 0x75), 0x68); // WHO_AM_I, clocked out next
+    mpu.deselect();
     assert!(dev.rig_mut().spi_target(2).is_none());
 }
 

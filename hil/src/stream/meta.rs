@@ -66,6 +66,7 @@ pub(super) fn metadata(
             // The others' conversions are their ranges, already in `[chip]`.
             Conversion::Icm42688p(_)
             | Conversion::Bmi270(_)
+            | Conversion::Bmi088(_)
             | Conversion::Ist8310
             | Conversion::Qmc5883l(_)
             | Conversion::Rm3100(_) => None,

@@ -240,8 +240,8 @@ mod tests {
             };
             assert_eq!(chip.settings(), ChipSettings::power_on(model), "{model:?}");
             let fs = FullScale {
-                accel_g: 16.0,
-                gyro_dps: 2000.0,
+                accel_g: ChipSettings::accel_ranges_g(model).last().unwrap_or(0.0),
+                gyro_dps: ChipSettings::gyro_ranges_dps(model).last().unwrap_or(0.0),
             };
             let settings = if model.is_magnetometer_only() {
                 let gauss = ChipSettings::mag_ranges_gauss(model).last().copied();

@@ -47,11 +47,25 @@ pub fn describe(model: ChipModel) -> String {
     let id = format!("{}:", model.identity_register());
     out += &format!("  {id:<14}{}\n", hexes(model.identities()));
     let spi = model.buses().contains(margemu_protocol::link::Buses::SPI);
-    out += &format!(
-        "  buses:        {}I2C at {}\n",
-        if spi { "SPI, " } else { "" },
-        hexes(model.i2c_addresses())
-    );
+    out += &match model.second_die_i2c_address(model.i2c_addresses()[0]) {
+        Some(_) => {
+            let gyro: Vec<u8> = (model.i2c_addresses().iter())
+                .filter_map(|&a| model.second_die_i2c_address(a))
+                .collect();
+            format!(
+                "  buses:        SPI on {} chip selects (accel die, then gyro die), I2C at {} \
+                 (accel die; gyro die at {} alike)\n",
+                model.spi_selects(),
+                hexes(model.i2c_addresses()),
+                hexes(&gyro)
+            )
+        }
+        None => format!(
+            "  buses:        {}I2C at {}\n",
+            if spi { "SPI, " } else { "" },
+            hexes(model.i2c_addresses())
+        ),
+    };
     if let Some(fs) = power_on.full_scale() {
         out += &format!(
             "  accel ranges: ± {} g (power-on ±{} g)\n",
@@ -100,6 +114,8 @@ fn rates(model: ChipModel) -> String {
     let candidates: &[f64] = match model {
         // The gyro ODRs, 100 Hz · 2^n.
         ChipModel::Bmi270 => &[3_200.0, 1_600.0, 800.0, 400.0, 200.0, 100.0, 50.0, 25.0],
+        // The gyro ODRs of GYRO_BANDWIDTH.
+        ChipModel::Bmi088 => &[2_000.0, 1_000.0, 400.0, 200.0, 100.0],
         _ => &[
             32_000.0, 16_000.0, 8_000.0, 4_000.0, 2_000.0, 1_000.0, 500.0, 200.0, 100.0, 50.0,
             25.0, 12.5,
@@ -114,7 +130,7 @@ fn rates(model: ChipModel) -> String {
     match model {
         ChipModel::Mpu6000 => format!("{listed}, … (8 kHz or 1 kHz / (1 + SMPLRT_DIV))"),
         ChipModel::Icm42688p => listed,
-        ChipModel::Bmi270 => {
+        ChipModel::Bmi270 | ChipModel::Bmi088 => {
             format!("{listed} (the gyro's ODR; the accelerometer at its own, at most 1.6 kHz)")
         }
         _ => format!("{listed}, … (32 kHz, 8 kHz, or 1 kHz / (1 + SMPLRT_DIV))"),

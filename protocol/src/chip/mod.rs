@@ -12,8 +12,8 @@
 //!   evaluation decodes with it.
 //!
 //! Only the chip modules ([`crate::regmap::mpu6xxx`], [`crate::regmap::ak8963`],
-//! [`crate::regmap::icm42688p`], [`crate::regmap::bmi270`]) name registers; this module
-//! dispatches to them.
+//! [`crate::regmap::icm42688p`], [`crate::regmap::bmi270`], [`crate::regmap::bmi088`], the
+//! magnetometers') name registers; this module dispatches to them.
 //!
 //! ```
 //! use margemu_protocol::chip::{ChipModel, ChipSettings, PhysicalSample};

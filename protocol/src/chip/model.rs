@@ -19,6 +19,8 @@ pub enum Family {
     Rm3100,
     /// Bosch BMI270 ([`crate::regmap::bmi270`]).
     Bmi270,
+    /// Bosch BMI088, two dies ([`crate::regmap::bmi088`]).
+    Bmi088,
 }
 
 /// An emulated chip model. Its wire code ([`ChipModel::code`]) is the bit of
@@ -45,11 +47,14 @@ pub enum ChipModel {
     Qmc5883l = 7,
     /// PNI RM3100 magnetometer (SPI and I2C), REVID 0x22.
     Rm3100 = 8,
+    /// Bosch BMI088 (accelerometer and gyroscope dies, one chip select or I2C address each),
+    /// ACC_CHIP_ID 0x1E.
+    Bmi088 = 9,
 }
 
 impl ChipModel {
     /// Every model, in code order.
-    pub const ALL: [Self; 9] = [
+    pub const ALL: [Self; 10] = [
         Self::Mpu9250,
         Self::Mpu6500,
         Self::Mpu6000,
@@ -59,6 +64,7 @@ impl ChipModel {
         Self::Ist8310,
         Self::Qmc5883l,
         Self::Rm3100,
+        Self::Bmi088,
     ];
 
     /// The model's code on the link.
@@ -83,6 +89,7 @@ impl ChipModel {
             Self::Qmc5883l => "qmc5883l",
             Self::Rm3100 => "rm3100",
             Self::Bmi270 => "bmi270",
+            Self::Bmi088 => "bmi088",
         }
     }
 
@@ -98,6 +105,7 @@ impl ChipModel {
             Self::Qmc5883l => "QMC5883L",
             Self::Rm3100 => "RM3100",
             Self::Bmi270 => "BMI270",
+            Self::Bmi088 => "BMI088",
         }
     }
 
@@ -121,6 +129,7 @@ impl ChipModel {
             Self::Qmc5883l => Family::Qmc5883l,
             Self::Rm3100 => Family::Rm3100,
             Self::Bmi270 => Family::Bmi270,
+            Self::Bmi088 => Family::Bmi088,
             _ => Family::Mpu6xxx,
         }
     }
@@ -133,16 +142,18 @@ impl ChipModel {
 
     /// The WHO_AM_I value of the part itself (the first of [`ChipModel::identities`]; for the
     /// magnetometers, the identity register drivers check: the IST8310's WAI, the
-    /// QMC5883L's chip id register 0x0D, the RM3100's REVID; the BMI270's CHIP_ID).
+    /// QMC5883L's chip id register 0x0D, the RM3100's REVID; the BMI270's CHIP_ID; the BMI088's
+    /// accelerometer die's ACC_CHIP_ID).
     pub const fn who_am_i(self) -> u8 {
         self.identities()[0]
     }
 
     /// The name of the identity register the datasheet gives ([`ChipModel::identities`] are
-    /// its values): `"WHO_AM_I"`, the BMI270's `"CHIP_ID"`.
+    /// its values): `"WHO_AM_I"`, the BMI270's `"CHIP_ID"`, the BMI088's `"ACC_CHIP_ID"`.
     pub const fn identity_register(self) -> &'static str {
         match self {
             Self::Bmi270 => "CHIP_ID",
+            Self::Bmi088 => "ACC_CHIP_ID",
             Self::Ist8310 => "WAI",
             Self::Qmc5883l => "CHIP_ID 0x0D",
             Self::Rm3100 => "REVID",
@@ -163,6 +174,7 @@ impl ChipModel {
             Self::Qmc5883l => &[crate::regmap::qmc5883l::CHIP_ID_VALUE],
             Self::Rm3100 => &[crate::regmap::rm3100::REVID_VALUE],
             Self::Bmi270 => &[crate::regmap::bmi270::CHIP_ID],
+            Self::Bmi088 => &[crate::regmap::bmi088::accel::CHIP_ID],
         }
     }
 
@@ -177,10 +189,16 @@ impl ChipModel {
 
     /// The 7-bit I2C addresses the part can be strapped to (the default first: AD0 low for the
     /// InvenSense IMUs, SDO low for the BMI270; the IST8310's CAD pins give 0x0C–0x0F, 0x0E with
-    /// both low; the QMC5883L has one; the RM3100's SA0/SA1 pins give 0x20–0x23).
+    /// both low; the QMC5883L has one; the RM3100's SA0/SA1 pins give 0x20–0x23; the BMI088's
+    /// accelerometer die, SDO1 low or high: its gyroscope die answers
+    /// [`ChipModel::second_die_i2c_address`] too).
     pub const fn i2c_addresses(self) -> &'static [u8] {
         match self {
             Self::Bmi270 => &crate::regmap::bmi270::I2C_ADDRESSES,
+            Self::Bmi088 => &[
+                crate::regmap::bmi088::accel::I2C_ADDRESS,
+                crate::regmap::bmi088::accel::I2C_ADDRESS | 1,
+            ],
             Self::Ist8310 => &crate::regmap::ist8310::I2C_ADDRESSES,
             Self::Qmc5883l => &[crate::regmap::qmc5883l::I2C_ADDRESS],
             Self::Rm3100 => &[0x20, 0x21, 0x22, 0x23],
@@ -188,12 +206,33 @@ impl ChipModel {
         }
     }
 
+    /// The 7-bit I2C address of the part's second die when the part is strapped to `address`
+    /// (one of [`ChipModel::i2c_addresses`]): the BMI088's gyroscope die, 0x68 with SDO1 low
+    /// and 0x69 with it high (margemu straps SDO2 as SDO1: one `address` names both dies).
+    /// `None` for the one-die parts.
+    pub const fn second_die_i2c_address(self, address: u8) -> Option<u8> {
+        match self {
+            Self::Bmi088 => Some(crate::regmap::bmi088::gyro::I2C_ADDRESS | (address & 1)),
+            _ => None,
+        }
+    }
+
+    /// SPI chip selects the part takes: 2 for the BMI088 (CSB1 its accelerometer die, CSB2 its
+    /// gyroscope die), 1 otherwise. A device on chip select `c` takes `c .. c + spi_selects()`.
+    pub const fn spi_selects(self) -> u8 {
+        match self {
+            Self::Bmi088 => 2,
+            _ => 1,
+        }
+    }
+
     /// Register files of the model, as [`RegisterOverride::file`](crate::link::RegisterOverride)
     /// numbers them: the MPU-9250's die (0) and its AK8963 (1); the ICM-42688-P's banks 0–4;
-    /// one file otherwise (the BMI270's one page of 128 registers).
+    /// the BMI088's accelerometer die (0) and gyroscope die (1); one file otherwise (the
+    /// BMI270's one page of 128 registers).
     pub const fn register_files(self) -> u8 {
         match self {
-            Self::Mpu9250 => 2,
+            Self::Mpu9250 | Self::Bmi088 => 2,
             Self::Icm42688p => 5,
             _ => 1,
         }
@@ -238,6 +277,17 @@ impl ChipModel {
                 "FIFO: headered and headerless frames, FIFO_DOWNS, stop-on-full or fifo_err, flush",
                 "INT1/INT2: data ready, pulsed (156.25 µs) or latched, level, open drain, output enable",
             ],
+            Family::Bmi088 => &[
+                "both dies, each with its registers, reset values, write masks and read-back",
+                "two chip selects (accel, gyro) or two I2C addresses; the accel's dummy byte and \
+                 switch from I2C on a chip-select rising edge",
+                "16-bit little-endian data at the configured ranges; the gyro at the served rate, \
+                 the accel at its own ODR; temperature every 1.28 s; SENSORTIME",
+                "power modes (ACC_PWR_CTRL, GYRO_LPM1); ERR_REG on an invalid ACC_CONF",
+                "both FIFOs: accel 0x84 frames with skip and sensortime frames, down-sampling; \
+                 gyro 6-byte frames, FIFO and stream modes, frame count and overrun",
+                "INT1/INT2 (accel) and INT3/INT4 (gyro) mapping, level, open drain",
+            ],
             Family::Ist8310 => &[
                 "I2C target at its four strap addresses, registers with reset values and masks",
                 "single measurements (CNTL1 = 1) taking the time the averaging (AVGCNTL) needs",
@@ -273,6 +323,12 @@ impl ChipModel {
             }
             Family::Qmc5883l => &["temperature output, over-sampling noise, the DRDY pin"],
             Family::Rm3100 => &["the DRDY pin, noise, the output's bend beyond +-800 uT"],
+            Family::Bmi088 => &[
+                "the filters' effect on the data (ACC_CONF bwp and GYRO_BANDWIDTH are stored)",
+                "boot, reset and power-mode settling times, write spacing in suspend",
+                "self-test responses, FIFO tags and input pins, external FIFO sync",
+                "a board's second chip select (the Black Pill serves device 0's accel die)",
+            ],
             Family::Bmi270 => &[
                 "the filters' effect on the data, pre-filtered FIFO data (settings are stored)",
                 "the configuration file's features (FEATURES pages are storage), the time init takes",
@@ -294,6 +350,7 @@ impl ChipModel {
             Self::Qmc5883l => crate::regmap::qmc5883l::IMAGE_LEN,
             Self::Rm3100 => crate::regmap::rm3100::IMAGE_LEN,
             Self::Bmi270 => crate::regmap::bmi270::image::IMAGE_LEN,
+            Self::Bmi088 => crate::regmap::bmi088::image::IMAGE_LEN,
         }
     }
 
@@ -303,7 +360,8 @@ impl ChipModel {
     /// 32 kHz (FCHOICE_B), 8 kHz (DLPF_CFG 0 or 7), or 1 kHz / (1 + SMPLRT_DIV) (the divider
     /// applies only with the DLPF on; RM-MPU-9250A section 4.4). ICM-42688-P: its ODR codes.
     /// BMI270: its gyro ODR codes, 25 Hz to 3.2 kHz (the served rate is the gyro's; the
-    /// accelerometer runs at its own ODR, at most 1.6 kHz).
+    /// accelerometer runs at its own ODR, at most 1.6 kHz). BMI088: its gyro ODRs, 100 Hz to
+    /// 2 kHz, likewise (the accelerometer at its own ODR, at most 1.6 kHz).
     pub fn has_output_rate(self, rate_hz: f64) -> bool {
         let close = |r: f64| (r - rate_hz).abs() <= 1e-9 * r;
         let divided = |base: f64| (1..=256u32).any(|n| close(base / f64::from(n)));
@@ -316,6 +374,7 @@ impl ChipModel {
             // A magnetometer measures on its own schedule; any rate of the rig's IMU serves it.
             Self::Ist8310 | Self::Qmc5883l | Self::Rm3100 => rate_hz > 0.0,
             Self::Bmi270 => crate::regmap::bmi270::Odr::gyro_of_hz(rate_hz).is_some(),
+            Self::Bmi088 => crate::regmap::bmi088::gyro::Bandwidth::widest_at_hz(rate_hz).is_some(),
         }
     }
 }
@@ -354,6 +413,10 @@ mod tests {
         assert!(ChipModel::Bmi270.has_output_rate(25.0));
         assert!(!ChipModel::Bmi270.has_output_rate(1000.0));
         assert!(!ChipModel::Bmi270.has_output_rate(12.5));
+        assert!(ChipModel::Bmi088.has_output_rate(2000.0));
+        assert!(ChipModel::Bmi088.has_output_rate(100.0));
+        assert!(!ChipModel::Bmi088.has_output_rate(1600.0));
+        assert!(!ChipModel::Bmi088.has_output_rate(3200.0));
     }
 
     #[test]
@@ -364,5 +427,20 @@ mod tests {
         assert_eq!(m.identity_register(), "CHIP_ID");
         assert_eq!(m.i2c_addresses(), &[0x68, 0x69]);
         assert!(!m.has_magnetometer());
+        assert_eq!((m.spi_selects(), m.second_die_i2c_address(0x68)), (1, None));
+    }
+
+    #[test]
+    fn the_bmi088() {
+        let m = ChipModel::Bmi088;
+        assert_eq!((m.code(), m.who_am_i(), m.image_len()), (9, 0x1E, 14));
+        assert_eq!((m.family(), m.register_files()), (Family::Bmi088, 2));
+        assert_eq!(m.identity_register(), "ACC_CHIP_ID");
+        assert_eq!(m.i2c_addresses(), &[0x18, 0x19]);
+        assert_eq!(m.second_die_i2c_address(0x18), Some(0x68));
+        assert_eq!(m.second_die_i2c_address(0x19), Some(0x69));
+        assert_eq!(m.spi_selects(), 2);
+        assert_eq!(ChipModel::from_name("BMI-088"), Some(m));
+        assert!(!m.has_magnetometer() && !m.is_magnetometer_only());
     }
 }

@@ -2,6 +2,10 @@
 //! physical sample ↔ register image, dispatched to the chip's module.
 
 use super::{ChipModel, Family, Image, PhysicalSample};
+use crate::regmap::bmi088::image::{ImageConfig as Bmi088Config, ImageRepr as Bmi088Repr};
+use crate::regmap::bmi088::{
+    accel as bmi088_accel, convert as bmi088_convert, gyro as bmi088_gyro,
+};
 use crate::regmap::bmi270::image::{ImageConfig as BmiConfig, ImageRepr as BmiRepr};
 use crate::regmap::bmi270::{self as bmi, convert as bmi_convert};
 use crate::regmap::icm42688p::image::{ImageConfig as IcmConfig, ImageRepr as IcmRepr};
@@ -25,6 +29,8 @@ pub enum Conversion {
     Rm3100([u16; 3]),
     /// BMI270 (ranges).
     Bmi270(BmiConfig),
+    /// BMI088 (the accelerometer die's range, the gyroscope die's range).
+    Bmi088(Bmi088Config),
 }
 
 /// A full-scale choice: accelerometer range in g, gyroscope range in °/s.
@@ -90,6 +96,7 @@ impl ChipSettings {
             Family::Qmc5883l => Conversion::Qmc5883l(qmc5883l::Range::default()),
             Family::Rm3100 => Conversion::Rm3100([rm3100::reset::CYCLE_COUNT; 3]),
             Family::Bmi270 => Conversion::Bmi270(BmiConfig::NOMINAL),
+            Family::Bmi088 => Conversion::Bmi088(Bmi088Config::NOMINAL),
         };
         Self { model, conversion }
     }
@@ -149,6 +156,16 @@ impl ChipSettings {
                     .find(|g| g.range_dps() == fs.gyro_dps)
                     .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
             }
+            Conversion::Bmi088(cfg) => {
+                cfg.acc_range = bmi088_accel::AccRange::ALL
+                    .into_iter()
+                    .find(|a| f64::from(a.full_scale_g()) == fs.accel_g)
+                    .ok_or(SettingsError::AccelRange(fs.accel_g))?;
+                cfg.gyr_range = bmi088_gyro::GyroRange::ALL
+                    .into_iter()
+                    .find(|g| f64::from(g.full_scale_dps()) == fs.gyro_dps)
+                    .ok_or(SettingsError::GyroRange(fs.gyro_dps))?;
+            }
             Conversion::Ist8310 | Conversion::Qmc5883l(_) | Conversion::Rm3100(_) => {
                 return Err(SettingsError::AccelRange(fs.accel_g))
             }
@@ -166,6 +183,10 @@ impl ChipSettings {
             Family::Icm42688p => icm::AccelFs::ALL.iter().map(|a| a.range_g()).collect(),
             Family::Ist8310 | Family::Qmc5883l | Family::Rm3100 => heapless::Vec::new(),
             Family::Bmi270 => bmi::AccRange::ALL.iter().map(|a| a.range_g()).collect(),
+            Family::Bmi088 => bmi088_accel::AccRange::ALL
+                .iter()
+                .map(|a| f64::from(a.full_scale_g()))
+                .collect(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -181,6 +202,10 @@ impl ChipSettings {
             Family::Icm42688p => icm::GyroFs::ALL.iter().map(|g| g.range_dps()).collect(),
             Family::Ist8310 | Family::Qmc5883l | Family::Rm3100 => heapless::Vec::new(),
             Family::Bmi270 => bmi::GyrRange::ALL.iter().map(|g| g.range_dps()).collect(),
+            Family::Bmi088 => bmi088_gyro::GyroRange::ALL
+                .iter()
+                .map(|g| f64::from(g.full_scale_dps()))
+                .collect(),
         };
         ranges.sort_unstable_by(f64::total_cmp);
         ranges.into_iter()
@@ -201,6 +226,10 @@ impl ChipSettings {
                 accel_g: cfg.acc_range.range_g(),
                 gyro_dps: cfg.gyr_range.range_dps(),
             }),
+            Conversion::Bmi088(cfg) => Some(FullScale {
+                accel_g: f64::from(cfg.acc_range.full_scale_g()),
+                gyro_dps: f64::from(cfg.gyr_range.full_scale_dps()),
+            }),
             Conversion::Ist8310 | Conversion::Qmc5883l(_) | Conversion::Rm3100(_) => None,
         }
     }
@@ -220,8 +249,13 @@ impl ChipSettings {
     /// ICM-42688-P's GYRO_CONFIG0/ACCEL_CONFIG0; the 6xxx parts keep their power-on rate
     /// registers; the QMC5883L's range in CONF1, in stand-by: its driver starts it). The BMI270 gets its ranges and, in GYR_CONF and ACC_CONF (their other bits
     /// at the power-on values), the gyro ODR of `rate_hz` and the accel ODR nearest below or at
-    /// it (1.6 kHz for a 3.2 kHz gyro: the chip then takes every second image's accel). Writes
-    /// that would store the power-on value are left out.
+    /// it (1.6 kHz for a 3.2 kHz gyro: the chip then takes every second image's accel). The
+    /// BMI088 likewise, die by die (file 0 the accelerometer, file 1 the gyroscope): ACC_RANGE
+    /// and, in ACC_CONF (normal filter, as at power-on), the accel ODR at or below `rate_hz`
+    /// (1.6 kHz for a 2 kHz gyro, 800 Hz for 1 kHz); GYRO_RANGE and, in GYRO_BANDWIDTH, the
+    /// gyro ODR of `rate_hz` with its widest filter. Neither die is switched on: that is the
+    /// driver's (ACC_PWR_CTRL, GYRO_LPM1). Writes that would store the power-on value are left
+    /// out.
     pub fn config_writes(&self, rate_hz: f64) -> impl Iterator<Item = (u8, u8, u8)> {
         let writes: Writes = match &self.conversion {
             Conversion::Mpu6xxx(cfg) => writes(&[
@@ -242,6 +276,7 @@ impl ChipSettings {
                 ])
             }
             Conversion::Bmi270(cfg) => bmi270_writes(cfg, rate_hz),
+            Conversion::Bmi088(cfg) => bmi088_writes(cfg, rate_hz),
         };
         let model = self.model;
         writes
@@ -285,13 +320,17 @@ impl ChipSettings {
                 &mut image,
                 &BmiRepr::from_physical(acc, gyr, temp, cfg).emit(),
             ),
+            Conversion::Bmi088(cfg) => copy(
+                &mut image,
+                &Bmi088Repr::from_physical(acc, gyr, temp, cfg).emit(),
+            ),
         }
         image
     }
 
     /// The physical values an image of this model stands for under these settings; `None` if
     /// the image is not of the model's length. A BMI270 temperature of 0x8000 (invalid) reads
-    /// as NaN.
+    /// as NaN, and so does a BMI088 temperature of TEMP_MSB 0x80 (−1024).
     pub fn decode(&self, image: &[u8]) -> Option<Reading> {
         if image.len() != self.model.image_len() {
             return None;
@@ -334,6 +373,22 @@ impl ChipSettings {
                     mag_ut: None,
                 }
             }
+            Conversion::Bmi088(cfg) => {
+                let bytes: &[u8; crate::regmap::bmi088::image::IMAGE_LEN] =
+                    image.try_into().ok()?;
+                let r = Bmi088Repr::parse(bytes);
+                let temp = bmi088_convert::temp_bytes(r.temp);
+                Reading {
+                    acc: r
+                        .accel
+                        .map(|v| f64::from(bmi088_convert::accel_from_raw(v, cfg.acc_range))),
+                    gyr: r
+                        .gyro
+                        .map(|v| f64::from(bmi088_convert::gyro_from_raw(v, cfg.gyr_range))),
+                    temp_c: bmi088_convert::temp_from_bytes(temp).map_or(f64::NAN, f64::from),
+                    mag_ut: None,
+                }
+            }
             Conversion::Ist8310 | Conversion::Qmc5883l(_) | Conversion::Rm3100(_) => {
                 let mag = match self.conversion {
                     Conversion::Qmc5883l(range) => {
@@ -361,6 +416,8 @@ fn power_on_value(model: ChipModel, file: u8, reg: u8) -> u8 {
         (Family::Mpu6xxx, 0) => mpu::reset_value(reg),
         (Family::Icm42688p, bank) => icm::reset_value(bank, reg),
         (Family::Bmi270, 0) => bmi::reset_value(reg),
+        (Family::Bmi088, 0) => crate::regmap::bmi088::Die::Accel.reset_value(reg),
+        (Family::Bmi088, 1) => crate::regmap::bmi088::Die::Gyro.reset_value(reg),
         _ => 0,
     }
 }
@@ -389,6 +446,25 @@ fn bmi270_writes(cfg: &BmiConfig, rate_hz: f64) -> Writes {
         (0, bmi::reg::GYR_RANGE, cfg.gyr_range.bits()),
         conf(bmi::reg::GYR_CONF, bmi::Odr::gyro_of_hz(rate_hz)),
         conf(bmi::reg::ACC_CONF, bmi::Odr::accel_of_hz(accel_hz)),
+    ])
+}
+
+/// The BMI088's writes (see [`ChipSettings::config_writes`]): file 0 the accelerometer die,
+/// file 1 the gyroscope die.
+fn bmi088_writes(cfg: &Bmi088Config, rate_hz: f64) -> Writes {
+    use crate::regmap::bmi088::Die;
+    let acc_conf = Die::Accel.reset_value(bmi088_accel::reg::ACC_CONF);
+    let acc_conf = bmi088_accel::Odr::at_most_hz(rate_hz.min(bmi088_accel::Odr::HZ1600.hz()))
+        .map_or(acc_conf, |odr| (acc_conf & 0xF0) | odr.code());
+    let bandwidth = Die::Gyro.reset_value(bmi088_gyro::reg::BANDWIDTH);
+    let bandwidth = bmi088_gyro::Bandwidth::widest_at_hz(rate_hz).map_or(bandwidth, |bw| {
+        bmi088_gyro::bits::BANDWIDTH_FIXED | bw.code()
+    });
+    writes(&[
+        (0, bmi088_accel::reg::ACC_RANGE, cfg.acc_range.bits()),
+        (0, bmi088_accel::reg::ACC_CONF, acc_conf),
+        (1, bmi088_gyro::reg::RANGE, cfg.gyr_range.bits()),
+        (1, bmi088_gyro::reg::BANDWIDTH, bandwidth),
     ])
 }
 
@@ -463,6 +539,69 @@ mod tests {
                 .full_scale()
                 .map(|fs| fs.accel_g),
             Some(8.0)
+        );
+    }
+
+    #[test]
+    fn bmi088_config_writes_set_both_dies() {
+        let fs = |accel_g, gyro_dps| FullScale { accel_g, gyro_dps };
+        let s = ChipSettings::with_full_scale(ChipModel::Bmi088, fs(24.0, 1000.0)).unwrap();
+        let writes: Writes = s.config_writes(2000.0).collect();
+        // ACC_RANGE ±24 g, ACC_CONF 1.6 kHz (normal filter); GYRO_RANGE ±1000 °/s; GYRO_BANDWIDTH
+        // stays 2 kHz / 532 Hz (its power-on value).
+        assert_eq!(writes, [(0, 0x41, 0x03), (0, 0x40, 0xAC), (1, 0x0F, 0x01)]);
+        let s = ChipSettings::power_on(ChipModel::Bmi088);
+        let writes: Writes = s.config_writes(1000.0).collect();
+        assert_eq!(writes, [(0, 0x40, 0xAB), (1, 0x10, 0x82)]); // 800 Hz; 1 kHz / 116 Hz
+        let writes: Writes = s.config_writes(100.0).collect();
+        assert_eq!(writes, [(1, 0x10, 0x87)]); // accel 100 Hz at power-on; gyro 100 Hz / 32 Hz
+        assert_eq!(
+            ChipSettings::with_full_scale(ChipModel::Bmi088, fs(16.0, 2000.0)),
+            Err(SettingsError::AccelRange(16.0))
+        );
+        assert_eq!(
+            ChipSettings::accel_ranges_g(ChipModel::Bmi088).collect::<heapless::Vec<f64, 8>>(),
+            [3.0, 6.0, 12.0, 24.0]
+        );
+        assert_eq!(
+            ChipSettings::gyro_ranges_dps(ChipModel::Bmi088).collect::<heapless::Vec<f64, 8>>(),
+            [125.0, 250.0, 500.0, 1000.0, 2000.0]
+        );
+    }
+
+    #[test]
+    fn bmi088_images_decode_to_what_was_converted() {
+        let fs = FullScale {
+            accel_g: 3.0,
+            gyro_dps: 250.0,
+        };
+        let s = ChipSettings::with_full_scale(ChipModel::Bmi088, fs).unwrap();
+        let sample = PhysicalSample {
+            acc: [1.0, -2.0, 9.80665],
+            gyr: [0.5, -1.0, 0.25],
+            temp_c: 31.625,
+            ..Default::default()
+        };
+        let image = s.image(&sample);
+        assert_eq!(image.len(), 14);
+        let r = s.decode(&image).unwrap();
+        for (got, want) in r.acc.iter().zip(sample.acc) {
+            assert!((got - f64::from(want)).abs() <= 9.80665 / 10922.0);
+        }
+        for (got, want) in r.gyr.iter().zip(sample.gyr) {
+            assert!((got - f64::from(want)).abs() <= (1.0f64 / 131.0).to_radians());
+        }
+        assert_eq!((r.temp_c, r.mag_ut), (31.625, None));
+        let mut invalid = [0u8; 14];
+        invalid[12] = 0x80;
+        assert!(s.decode(&invalid).unwrap().temp_c.is_nan());
+        assert_eq!(s.decode(&[0; 15]), None);
+        assert_eq!(
+            ChipSettings::power_on(ChipModel::Bmi088).full_scale(),
+            Some(FullScale {
+                accel_g: 6.0,
+                gyro_dps: 2000.0
+            })
         );
     }
 }

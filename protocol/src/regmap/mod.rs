@@ -12,6 +12,9 @@
 //! - [`bmi270`]: the Bosch BMI270: register map, access masks, ranges, output rates, the
 //!   configuration upload's registers and the conversions (little-endian data, temperature,
 //!   sensor time);
+//! - [`bmi088`]: the Bosch BMI088's two dies (accelerometer, gyroscope), each with its own
+//!   register map, access rules, ranges, output rates and FIFO registers, and their conversions
+//!   (little-endian data, 11-bit temperature, sensor time);
 //! - [`ist8310`]: the iSentek IST8310 standalone I2C magnetometer;
 //! - [`qmc5883l`]: the QST QMC5883L standalone I2C magnetometer;
 //! - [`rm3100`]: the PNI RM3100 magneto-inductive magnetometer (I2C or SPI, 24-bit results);
@@ -27,6 +30,7 @@
 //! ```
 
 pub mod ak8963;
+pub mod bmi088;
 pub mod bmi270;
 pub mod icm42688p;
 pub mod ist8310;

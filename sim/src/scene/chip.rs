@@ -4,13 +4,15 @@
 //! [chip]
 //! model = "icm42688p"        # `margemu chips` lists them; default "mpu9250"
 //! bus = "spi"                # or "i2c" (default: SPI if the model has it)
-//! address = 0x69             # I2C only: one of the model's addresses (default its first)
+//! address = 0x69             # I2C only: one of the model's addresses (default its first; a
+//!                            # BMI088's accel die, its gyro die at 0x68/0x69 alike)
 //! who_am_i = 0x47            # an identity variant of the model (default its own)
 //! rotation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]  # plate → chip axes
 //! accel_range = 16           # ± g, one of the model's full scales (default: power-on)
 //! gyro_range = 2000          # ± °/s
 //! mag_range = 8              # ± gauss: a magnetometer with a choice of ranges (QMC5883L: 2, 8)
-//! chip_select = 0            # SPI only: the chip-select line, 0..=3 (default 0)
+//! chip_select = 0            # SPI only: the chip-select line, 0..=3 (default 0); a BMI088
+//!                            # takes it (accel die) and the next one (gyro die)
 //! offset = [0.02, 0.0, -0.01]  # m, plate axes: the lever arm from the plate's reference point
 //! name = "imu"               # the device's name in logs (default: the model's name)
 //! ```
@@ -388,9 +390,20 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
             ),
         ));
     }
+    let last_select = MAX_CHIP_SELECTS - model.spi_selects();
     let chip_select = match (bus, spec.chip_select) {
         (_, None) => 0,
-        (BusKind::Spi, Some(cs)) if cs < MAX_CHIP_SELECTS => cs,
+        (BusKind::Spi, Some(cs)) if cs <= last_select => cs,
+        (BusKind::Spi, Some(cs)) if model.spi_selects() > 1 && cs < MAX_CHIP_SELECTS => {
+            return Err(Violation::at(
+                &["chip", "chip_select"],
+                format!(
+                    "the {part} takes chip select {cs} and the next one (its gyroscope die), \
+                     but a board has chip selects 0..={}: use one of 0..={last_select}",
+                    MAX_CHIP_SELECTS - 1
+                ),
+            ))
+        }
         (BusKind::Spi, Some(cs)) => {
             return Err(Violation::at(
                 &["chip", "chip_select"],

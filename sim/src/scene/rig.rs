@@ -25,10 +25,12 @@
 //!
 //! Checked across devices, each refusal located at the offending key: names unique (a name
 //! is the device's column in the logs: letters, digits, `_` and `-`), no two I2C devices
-//! answering one address (an MPU-9250 on I2C also answers 0x0C, its AK8963 in bypass mode), no
-//! two SPI devices on one chip select, the scene's rate an output rate of every IMU in the rig
-//! (a magnetometer measures on its own schedule), and the devices' images together at most
-//! [`MAX_IMAGE_LEN`] bytes (64: two ICM-42688-Ps, or an IMU, a second IMU and a compass).
+//! answering one address (an MPU-9250 on I2C also answers 0x0C, its AK8963 in bypass mode; a
+//! BMI088 its gyro die's 0x68 or 0x69 too), no two SPI devices on one chip select (a BMI088
+//! takes its `chip_select` for the accel die and the next one for the gyro die), the scene's
+//! rate an output rate of every IMU in the rig (a magnetometer measures on its own schedule),
+//! and the devices' images together at most [`MAX_IMAGE_LEN`] bytes (64: two ICM-42688-Ps, or
+//! an IMU, a second IMU and a compass).
 //!
 //! ```
 //! let text = "duration = 1.0\nrate = 1000.0\nseed = 1\n\
@@ -123,14 +125,8 @@ fn resolve_all(
                 ),
             ));
         }
-        if let Some(other) = spi_clash(&rig, &setup) {
-            return Err(Violation::at_path(
-                at("chip_select"),
-                format!(
-                    "chip select {} is device `{other}`'s already",
-                    setup.chip_select
-                ),
-            ));
+        if let Some(why) = spi_clash(&rig, &setup) {
+            return Err(Violation::at_path(at("chip_select"), why));
         }
         let image_len: usize = rig.iter().map(|d| d.chip.model.image_len()).sum();
         let total = image_len + setup.model.image_len();
@@ -148,13 +144,25 @@ fn resolve_all(
     Ok(rig)
 }
 
-/// The 7-bit addresses a chip on I2C answers: its own, and for the MPU-9250 its AK8963 in
-/// bypass mode.
+/// The 7-bit addresses a chip on I2C answers: its own, for the MPU-9250 its AK8963 in bypass
+/// mode, for the BMI088 its gyro die.
 fn i2c_addresses(chip: &ChipSetup) -> Vec<u8> {
+    let second = chip.model.second_die_i2c_address(chip.i2c_address);
     match (chip.bus, chip.model) {
         (BusKind::Spi, _) => vec![],
         (BusKind::I2c, ChipModel::Mpu9250) => vec![chip.i2c_address, AK8963_ADDRESS],
-        (BusKind::I2c, _) => vec![chip.i2c_address],
+        (BusKind::I2c, _) => [Some(chip.i2c_address), second]
+            .into_iter()
+            .flatten()
+            .collect(),
+    }
+}
+
+/// The chip selects a chip on SPI takes: its own, and the next for a BMI088's gyro die.
+fn chip_selects(chip: &ChipSetup) -> std::ops::Range<u8> {
+    match chip.bus {
+        BusKind::Spi => chip.chip_select..chip.chip_select + chip.model.spi_selects(),
+        BusKind::I2c => 0..0,
     }
 }
 
@@ -170,14 +178,30 @@ fn i2c_clash(rig: &[Device], chip: &ChipSetup) -> Option<(String, u8)> {
     })
 }
 
+/// Why `chip` cannot have its chip selects: which one is whose already.
 fn spi_clash(rig: &[Device], chip: &ChipSetup) -> Option<String> {
-    (chip.bus == BusKind::Spi)
-        .then(|| {
-            rig.iter()
-                .find(|d| d.chip.bus == BusKind::Spi && d.chip.chip_select == chip.chip_select)
-                .map(|d| d.name.clone())
+    let mine = chip_selects(chip);
+    rig.iter().find_map(|d| {
+        let theirs = chip_selects(&d.chip);
+        let cs = mine.clone().find(|cs| theirs.contains(cs))?;
+        let other = &d.name;
+        let gyro = |part: &str| format!("the {part}'s gyroscope die (chip_select + 1)");
+        Some(if cs != chip.chip_select {
+            let part = chip.model.part_name();
+            format!(
+                "chip select {cs}, {}, is device `{other}`'s already",
+                gyro(part)
+            )
+        } else if cs != d.chip.chip_select {
+            let part = d.chip.model.part_name();
+            format!(
+                "chip select {cs} is device `{other}`'s already: {}",
+                gyro(part)
+            )
+        } else {
+            format!("chip select {cs} is device `{other}`'s already")
         })
-        .flatten()
+    })
 }
 
 fn check_name(name: &str) -> Result<(), String> {

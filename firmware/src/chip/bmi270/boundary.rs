@@ -124,6 +124,6 @@ impl Chip for Bmi270 {
         spi_read_burst_on_copy(self, start, out);
     }
     fn spi_read_dummy(&self) -> Option<u8> {
-        self.is_spi_mode().then_some(super::spi::DUMMY)
+        self.is_spi_mode().then_some(super::super::bosch_spi::DUMMY)
     }
 }

@@ -23,9 +23,9 @@ pub(super) type I2cState = I2cPointer;
 impl I2cTarget for Bmi270 {
     fn start(&mut self, address: u8, read: bool) -> bool {
         if !self.i2c.is_active() {
-            self.reset_in_transaction = false;
+            self.i2c_resetting = false;
         }
-        let ours = address == self.i2c_address() && !self.spi_mode && !self.reset_in_transaction;
+        let ours = address == self.i2c_address() && !self.is_spi_mode() && !self.i2c_resetting;
         self.i2c.start(ours, read)
     }
 
@@ -36,7 +36,8 @@ impl I2cTarget for Bmi270 {
             I2cByte::Data(addr) => {
                 self.write_register(Bus::I2c, addr, byte);
                 self.i2c.move_to(next_address(addr));
-                if self.reset_in_transaction {
+                if core::mem::take(&mut self.soft_reset_seen) {
+                    self.i2c_resetting = true;
                     self.i2c.release();
                 }
                 true
@@ -56,7 +57,7 @@ impl I2cTarget for Bmi270 {
 
     fn stop(&mut self) {
         self.i2c.stop();
-        self.reset_in_transaction = false;
+        self.i2c_resetting = false;
         self.bus_went_idle();
     }
 }

@@ -13,7 +13,7 @@
 //! read returns 0x00 whatever the register, and a write is lost. The soft reset's own
 //! transaction does not count as the switching edge: the chip is still resetting when chip
 //! select rises, so a driver needs another dummy read after CMD = 0xB6, as Betaflight and
-//! ArduPilot do. The I2C target answers in either mode (the datasheet does not say it stops).
+//! ArduPilot do. Once in SPI mode the chip no longer answers its I2C address (`i2c.rs`).
 //!
 //! **Dummy byte** (DS: 6.2 SPI). In SPI mode every read clocks out one dummy byte (0x00 here)
 //! before the data of the addressed register; writes have none, and I2C reads have none.
@@ -114,14 +114,13 @@ use margemu_protocol::regmap::bmi270::{bits, reg, AccRange, GyrRange, Odr, I2C_A
 
 pub use margemu_protocol::regmap::bmi270::CONFIG_FILE_LENS;
 
-use super::spi_phase::SpiPhase;
+use super::bosch_spi::BoschSpi;
 use super::write_log::{RegisterWrite, WriteLog};
 use super::PhysicalSample;
 use fifo::Fifo;
 use i2c::I2cState;
 use interrupts::Interrupts;
 use sample::Ticks;
-use spi::Dummy;
 use upload::Upload;
 
 /// Capacity of the register write log (entries of 4 bytes).
@@ -145,11 +144,11 @@ pub struct Bmi270 {
     regs: [u8; 128],
     /// A newer sample waiting for the bus to go idle: data registers, temperature, STATUS bits.
     pending: Option<([u8; LATCH_LEN], u8)>,
-    /// SPI selected by a chip-select rising edge (false: I2C mode after power-on or reset).
-    spi_mode: bool,
-    /// A soft reset happened in the current transaction: its chip-select edge does not count.
-    reset_in_transaction: bool,
-    dummy: Dummy,
+    /// A soft reset was commanded over the bus, for the SPI front end or the I2C target to take.
+    soft_reset_seen: bool,
+    /// A soft reset was written in the current I2C transaction: the chip answers no more START
+    /// until the STOP.
+    i2c_resetting: bool,
     /// SENSORTIME held by a read of SENSORTIME_0 until the transaction ends.
     sensortime_hold: Option<u32>,
     upload: Upload,
@@ -157,7 +156,7 @@ pub struct Bmi270 {
     ticks: Ticks,
     int: Interrupts,
     now_ns: u64,
-    spi: SpiPhase,
+    spi: BoschSpi,
     i2c: I2cState,
     log: WriteLog<WRITE_LOG_LEN>,
 }
@@ -180,16 +179,15 @@ impl Bmi270 {
             config,
             regs: [0; 128],
             pending: None,
-            spi_mode: false,
-            reset_in_transaction: false,
-            dummy: Dummy::None,
+            soft_reset_seen: false,
+            i2c_resetting: false,
             sensortime_hold: None,
             upload: Upload::default(),
             fifo: Fifo::default(),
             ticks: Ticks::default(),
             int: Interrupts::default(),
             now_ns: 0,
-            spi: SpiPhase::Idle,
+            spi: BoschSpi::new(),
             i2c: I2cState::default(),
             log: WriteLog::new(),
         };
@@ -200,7 +198,7 @@ impl Bmi270 {
     /// Power cycle: every register to its power-on value, back in I2C mode, time kept.
     pub fn power_cycle(&mut self) {
         self.soft_reset();
-        self.spi = SpiPhase::Idle;
+        self.spi = BoschSpi::new();
         self.i2c = I2cState::default();
     }
 
@@ -221,7 +219,7 @@ impl Bmi270 {
 
     /// Whether a chip-select edge has switched the interface to SPI.
     pub fn is_spi_mode(&self) -> bool {
-        self.spi_mode
+        self.spi.is_spi_mode()
     }
 
     /// Whether INTERNAL_STATUS reads init_ok: the sensors run.

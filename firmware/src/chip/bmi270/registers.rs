@@ -33,8 +33,9 @@ const RATE_REGISTERS: [u8; 5] = [
 ];
 
 impl Bmi270 {
-    /// Soft reset (and power-on): registers to their reset values, upload and latches cleared,
-    /// the interface back to I2C mode.
+    /// Soft reset (and power-on): registers to their reset values, upload and latches cleared.
+    /// A reset commanded over the bus also sets `soft_reset_seen`, which the SPI front end takes
+    /// to go back to I2C mode (and the I2C target to end its transaction).
     pub(super) fn soft_reset(&mut self) {
         for (addr, value) in (0u8..).zip(self.regs.iter_mut()) {
             *value = reset_value(addr);
@@ -43,7 +44,6 @@ impl Bmi270 {
         self.upload = Upload::default();
         self.fifo.flush();
         self.sensortime_hold = None;
-        self.spi_mode = false;
         self.ticks = Ticks::default();
         self.int_reset();
     }
@@ -116,7 +116,7 @@ impl Bmi270 {
             reg::CMD => {
                 if value == bits::CMD_SOFT_RESET {
                     self.soft_reset();
-                    self.reset_in_transaction = true;
+                    self.soft_reset_seen = true;
                 } else if value == bits::CMD_FIFO_FLUSH {
                     self.fifo_flush();
                 }

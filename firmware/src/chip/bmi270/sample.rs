@@ -5,39 +5,18 @@
 //! Nothing changes before the configuration upload has succeeded. A sensor that is off keeps
 //! its last data and raises no drdy. The gyro takes every latch (the sample clock is the
 //! gyro's ODR); the accelerometer and the temperature take a latch only when one of their own
-//! periods has begun ([`Tick`]): the accel ODR (at most 1.6 kHz) and 10 ms.
+//! periods has begun (`Tick`): the accel ODR (at most 1.6 kHz) and 10 ms.
 
 use margemu_protocol::regmap::bmi270::image::{field, ImageRepr, IMAGE_LEN};
 use margemu_protocol::regmap::bmi270::{bits, reg};
 
+use super::super::tick::Tick;
 use super::super::PhysicalSample;
 use super::{Bmi270, LATCH_LEN};
 
 /// How often the temperature register is updated, ns (ArduPilot's BMI270 driver: "temperature
 /// sensor updated every 10ms"; the BMI160 datasheet says the same of its own).
 pub const TEMP_PERIOD_NS: u64 = 10_000_000;
-
-/// A rate divider on the chip's clock: it fires at the first latch of each of its periods,
-/// the periods being the multiples of the period from time 0 (so a stream of latches at the
-/// gyro ODR gives a slower sensor every n-th latch, always the same ones).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(super) struct Tick {
-    /// Where the next period begins; `None`: the next latch fires.
-    next_ns: Option<u64>,
-}
-
-impl Tick {
-    /// Whether a latch at `now_ns` is the first of a period of `period_ns`; the period is then
-    /// used up.
-    pub(super) fn take(&mut self, now_ns: u64, period_ns: u64) -> bool {
-        if self.next_ns.is_some_and(|next| now_ns < next) {
-            return false;
-        }
-        let period = period_ns.max(1);
-        self.next_ns = Some((now_ns / period).saturating_add(1).saturating_mul(period));
-        true
-    }
-}
 
 /// The dividers of the slower sensors and of the FIFO's downsampling, restarted by a soft
 /// reset and by writes to the registers that set their rates.
@@ -126,23 +105,5 @@ fn copy_field(
 ) {
     if let (Some(to), Some(from)) = (latch.get_mut(range.clone()), image.get(range)) {
         to.copy_from_slice(from);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_tick_fires_once_per_period_on_the_grid() {
-        let mut t = Tick::default();
-        let fired = (0..9u64).map(|k| t.take(k * 312_500, 1_250_000));
-        let expected = [true, false, false, false, true, false, false, false, true];
-        assert!(fired.eq(expected));
-        let mut t = Tick::default();
-        assert!(t.take(7, 10)); // the first latch fires wherever it falls
-        assert!(!t.take(9, 10));
-        assert!(t.take(10, 10));
-        assert!(t.take(u64::MAX, 0)); // no panic at the ends
     }
 }
