@@ -9,7 +9,7 @@
 //! devices' mounting rotations. The compass's reading `v_c` (its own axes) is turned into the
 //! IMU's axes, the flight controller's body frame, as `v_imu = R_imu · R_cᵀ · v_c` (each `R` is
 //! a scene `rotation`, plate → chip axes;
-//! [`axes_between`](margemu_sim::scene::chip::axes_between)).
+//! [`axes_between`]).
 //!
 //! **The bus.** The chip belongs to the device's rig, as the IMU does (see [`super::board`]):
 //! for each batch of transactions the chip answering the compass's address
@@ -83,7 +83,7 @@ pub struct CompassConfig {
     /// The conversion the host computes the compass's images with (the QMC5883L's range).
     pub settings: ChipSettings,
     /// Compass axes → IMU axes
-    /// ([`axes_between`](margemu_sim::scene::chip::axes_between)).
+    /// ([`axes_between`]).
     pub to_body: Rotation,
 }
 
