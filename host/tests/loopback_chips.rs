@@ -112,6 +112,7 @@ fn rig_fixture_serves_every_devices_image_as_predicted() {
     );
     let row: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!((row[4].len(), row[5].len()), (64, 12), "{row:?}");
+    check_device_truth(&dir);
     let meta = meta(&dir);
     assert_eq!(meta["chip"]["name"].as_str(), Some("imu"));
     let others = meta["other_devices"].as_array().unwrap();
@@ -205,6 +206,39 @@ fn a_rig_with_a_bmi088_serves_every_devices_image_as_predicted() {
     assert_eq!(others[0]["chip_select"].as_integer(), Some(1));
     let _ = std::fs::remove_dir_all(&run);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `device_truth.csv` of the fixture rig: a row per sample and device; the compass (flipped
+/// about x, 2 cm and 4 cm off the centre) sees the IMU's rate and field turned by its rotation,
+/// and a specific force that differs from the IMU's turned one by its lever arm alone.
+fn check_device_truth(dir: &Path) {
+    let text = std::fs::read_to_string(dir.join("device_truth.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("t_ns,device,wx,wy,wz,fx,fy,fz,dwx,dwy,dwz,mx,my,mz")
+    );
+    let rows: Vec<Vec<String>> = lines
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect();
+    assert_eq!(rows.len(), 2 * 1000);
+    let num = |row: &[String], i: usize| row[i].parse::<f64>().unwrap();
+    let mut largest_lever = 0.0f64;
+    for pair in rows.chunks(2) {
+        let [imu, compass] = pair else { panic!() };
+        assert_eq!((imu[1].as_str(), compass[1].as_str(), &imu[0]), ("imu", "compass", &compass[0]));
+        let flip = [1.0, -1.0, -1.0];
+        for axis in 0..3 {
+            for first in [2, 11] {
+                // Rate and field: the same vectors in the flipped axes, exactly.
+                assert_eq!(num(compass, first + axis), flip[axis] * num(imu, first + axis));
+            }
+            let lever = num(compass, 5 + axis) - flip[axis] * num(imu, 5 + axis);
+            largest_lever = largest_lever.max(lever.abs());
+        }
+    }
+    // ω̇×r + ω×(ω×r) with |r| = 4.5 cm on the wobble: present, and small.
+    assert!(largest_lever > 1e-3 && largest_lever < 2.0, "{largest_lever}");
 }
 
 #[test]

@@ -10,6 +10,7 @@
 //! | file | columns |
 //! |---|---|
 //! | `truth.csv` | as `simulate` writes it (`docs/ground-truth.md`), one row per sample, written as the session predicts them (in order, a window ahead of what it sends): every sample of the scene once the session completes |
+//! | `device_truth.csv` | a rig's only: `t_ns,device,wx,wy,wz,fx,fy,fz,dwx,dwy,dwz,mx,my,mz`, each sample's truth per device in the device's own axes, the specific force at its mounting point ([`super::device_truth`]) |
 //! | `sent.csv` | one row per item written, in the order written. Source images: `index,t_ns,send_ns,late_ns,image,resend`: sample index, its latch instant, when the write of its batch to the port completed, how late that was against the batch's schedule `start_host_ns + t_ns − lead` of its first sample (empty for the prefill, written before Start, and for resends), the register image as two lowercase hex digits per byte (`Image`'s `{:x}`, read back by `Image::parse_hex`; 44 digits for the 22-byte MPU-9250 image), and `1` if the item was written again because the device had not received it (go-back-N; `0` for the first copy). Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend`: the kinematics sample's index and instant at the kinematics rate, the same times, the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip, and the resend flag |
 //! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample and for entries the check cannot verify (see `served.rs`) |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
@@ -24,7 +25,9 @@
 use margemu_model::sensor;
 use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
 use margemu_sim::meta::{Appended, SessionMeta};
+use super::device_truth::DeviceTruthWriter;
 use margemu_sim::output::{TruthWriter, TRUTH_FILE};
+use margemu_sim::scene::rig::Device;
 use margemu_sim::truth::Truth;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -44,8 +47,9 @@ pub const REGISTER_WRITES_FILE: &str = "register_writes.csv";
 pub const EVENTS_FILE: &str = "events.csv";
 
 /// The files of a session besides `meta.toml`.
-pub const SESSION_FILES: [&str; 7] = [
+pub const SESSION_FILES: [&str; 8] = [
     TRUTH_FILE,
+    super::device_truth::DEVICE_TRUTH_FILE,
     SENT_FILE,
     SERVED_FILE,
     DEVICE_FILE,
@@ -136,6 +140,8 @@ pub struct SessionLog {
     image_split: Vec<usize>,
     /// Who register writes reach.
     devices: Vec<WrittenDevice>,
+    /// A rig's `device_truth.csv`.
+    device_truth: Option<DeviceTruthWriter>,
 }
 
 fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
@@ -146,12 +152,13 @@ fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
 
 impl SessionLog {
     /// Creates `dir` and every file, with their headers (`sent`: what `sent.csv` holds), and
-    /// writes `meta.toml`; `devices` name the device of each register write.
+    /// writes `meta.toml`; `devices` are the scene's (they name the device of each register
+    /// write, and a rig's get their truth in `device_truth.csv`).
     pub fn create(
         dir: &Path,
         meta: &SessionMeta,
         sent: &SentLayout,
-        devices: Vec<WrittenDevice>,
+        devices: &[Device],
     ) -> io::Result<Self> {
         let image_split = match sent {
             SentLayout::Images(devices) if devices.len() > 1 => {
@@ -175,7 +182,8 @@ impl SessionLog {
                 File::create(dir.join(TRUTH_FILE))?,
             ))?,
             image_split,
-            devices,
+            devices: written_devices(devices),
+            device_truth: DeviceTruthWriter::create(dir, devices)?,
         };
         log.flush()?;
         Ok(log)
@@ -191,9 +199,13 @@ impl SessionLog {
         margemu_sim::meta::append(&self.dir, table)
     }
 
-    /// Rows of `truth.csv`, in order.
+    /// Rows of `truth.csv` (and a rig's `device_truth.csv`), in order.
     pub fn truth(&mut self, truths: &[Truth]) -> io::Result<()> {
-        truths.iter().try_for_each(|t| self.truth.write(t))
+        truths.iter().try_for_each(|t| self.truth.write(t))?;
+        match &mut self.device_truth {
+            Some(d) => d.write(truths),
+            None => Ok(()),
+        }
     }
 
     /// One row of `sent.csv` in source mode images.
@@ -361,6 +373,36 @@ impl SessionLog {
         self.telemetry.flush()?;
         self.register_writes.flush()?;
         self.truth.flush()?;
+        if let Some(d) = &mut self.device_truth {
+            d.flush()?;
+        }
         self.events.flush()
     }
+}
+
+/// The scene's devices as `register_writes.csv` names them: device 0 on chip select 0 (the
+/// device reports its SPI writes so), the others on their own; every I2C address each answers.
+fn written_devices(devices: &[Device]) -> Vec<WrittenDevice> {
+    use margemu_sim::scene::chip::BusKind;
+    devices
+        .iter()
+        .enumerate()
+        .map(|(i, d)| {
+            let chip = d.chip;
+            let chip_select = match (i, chip.bus) {
+                (0, _) => Some(0),
+                (_, BusKind::Spi) => Some(chip.chip_select),
+                (_, BusKind::I2c) => None,
+            };
+            let mut i2c_addresses = vec![chip.i2c_address];
+            if chip.model.has_magnetometer() && !chip.model.is_magnetometer_only() {
+                i2c_addresses.push(margemu_protocol::regmap::ak8963::I2C_ADDRESS);
+            }
+            WrittenDevice {
+                name: d.name.clone(),
+                chip_select,
+                i2c_addresses,
+            }
+        })
+        .collect()
 }

@@ -77,6 +77,7 @@
 //! `events.csv`.
 
 pub mod clock;
+pub mod device_truth;
 mod ending;
 mod flow;
 pub mod images;

@@ -6,7 +6,7 @@
 use super::clock::SystemClock;
 use super::flow::Run;
 use super::images::{predict_images, ImageSettings};
-use super::log::{SentLayout, SessionLog, WrittenDevice};
+use super::log::{SentLayout, SessionLog};
 use super::logger::Logger;
 use super::meta::metadata;
 use super::model::predict_model;
@@ -148,7 +148,8 @@ impl Session {
             ),
             Items::Kinematics { .. } => SentLayout::Kinematics,
         };
-        let log = SessionLog::create(dir, &meta, &sent, written_devices(scene)).map_err(log_err)?;
+        let devices = scene.devices();
+        let log = SessionLog::create(dir, &meta, &sent, &devices).map_err(log_err)?;
         let log = Logger::spawn(log).map_err(log_err)?;
         let others = scene.other_devices.iter().map(|d| d.chip).collect();
         let chips = (scene.chip, others);
@@ -388,30 +389,3 @@ fn gcd(a: u64, b: u64) -> u64 {
     }
 }
 
-/// The scene's devices as `register_writes.csv` names them: device 0 on chip select 0 (the
-/// device reports its SPI writes so), the others on their own; every I2C address each answers.
-fn written_devices(scene: &Scene) -> Vec<WrittenDevice> {
-    use margemu_sim::scene::chip::BusKind;
-    scene
-        .devices()
-        .into_iter()
-        .enumerate()
-        .map(|(i, d)| {
-            let chip = d.chip;
-            let chip_select = match (i, chip.bus) {
-                (0, _) => Some(0),
-                (_, BusKind::Spi) => Some(chip.chip_select),
-                (_, BusKind::I2c) => None,
-            };
-            let mut i2c_addresses = vec![chip.i2c_address];
-            if chip.model.has_magnetometer() && !chip.model.is_magnetometer_only() {
-                i2c_addresses.push(margemu_protocol::regmap::ak8963::I2C_ADDRESS);
-            }
-            WrittenDevice {
-                name: d.name,
-                chip_select,
-                i2c_addresses,
-            }
-        })
-        .collect()
-}
