@@ -22,10 +22,10 @@
 //! ended; [`margemu_sim::rundir`]), written once every file is closed: after the session, or after
 //! the device under test's reader when one is attached.
 
+use super::device_truth::DeviceTruthWriter;
 use margemu_model::sensor;
 use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
 use margemu_sim::meta::{Appended, SessionMeta};
-use super::device_truth::DeviceTruthWriter;
 use margemu_sim::output::{TruthWriter, TRUTH_FILE};
 use margemu_sim::scene::rig::Device;
 use margemu_sim::truth::Truth;
