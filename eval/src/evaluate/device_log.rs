@@ -19,7 +19,7 @@
 //! magnetometer alone ([`ExternalCompass`]: its column `image.NAME`, its model and range from
 //! its `[[other_devices]]` table), turned from the compass's axes into device 0's with both
 //! devices' `rotation`s (`v_0 = R_0 · R_cᵀ · v_c`,
-//! [`axes_between`](margemu_sim::scene::chip::axes_between)). A rig without such a compass
+//! [`axes_between`]). A rig without such a compass
 //! keeps device 0's own magnetometer, as a single chip does.
 
 use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion, FullScale, Image};
