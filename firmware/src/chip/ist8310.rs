@@ -36,8 +36,8 @@
 use margemu_protocol::regmap::ist8310::{self as map, bits, reg, reset, Mode};
 
 use super::magnetometer::{flag, Held, MAG_WRITE_LOG_LEN};
-use super::pointer_i2c::{PointerI2c, Step};
-use super::{Bus, I2cTarget, RegisterWrite, WriteLog};
+use super::pointer_i2c::PointerI2c;
+use super::WriteLog;
 
 /// The IST8310.
 #[derive(Clone, Debug)]
@@ -58,7 +58,7 @@ pub struct Ist8310 {
     held: Held,
     pointer: u8,
     address: u8,
-    bus: PointerI2c,
+    pub(super) bus: PointerI2c,
     pub(super) log: WriteLog<MAG_WRITE_LOG_LEN>,
 }
 
@@ -247,44 +247,10 @@ impl Ist8310 {
     }
 }
 
-impl I2cTarget for Ist8310 {
-    fn start(&mut self, address: u8, read: bool) -> bool {
-        self.bus.start(address == self.address, read)
-    }
-
-    fn write(&mut self, byte: u8) -> bool {
-        match self.bus.write(byte) {
-            Step::Pointer(addr) => self.pointer = addr,
-            Step::Data(value) => {
-                let register = self.write_next(value);
-                self.log.push(RegisterWrite {
-                    bus: Bus::I2c,
-                    device: self.address,
-                    register,
-                    value,
-                });
-            }
-            Step::Ignored => return false,
-        }
-        true
-    }
-
-    fn read(&mut self) -> u8 {
-        if self.bus.may_read() {
-            self.read_next()
-        } else {
-            0xFF
-        }
-    }
-
-    fn stop(&mut self) {
-        self.bus.stop();
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::chip::I2cTarget;
 
     const MS: u64 = 1_000_000;
 

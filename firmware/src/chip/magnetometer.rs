@@ -29,7 +29,8 @@
 use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion, PhysicalSample};
 use margemu_protocol::regmap::{ist8310, mag_image, qmc5883l};
 
-use super::{Chip, I2cTarget, Ist8310, Qmc5883l, RegisterWrite, SpiTarget};
+use super::pointer_i2c::Step;
+use super::{Bus, Chip, I2cTarget, Ist8310, Qmc5883l, RegisterWrite, SpiTarget};
 
 /// Register writes a magnetometer keeps for the link (a driver writes a few per measurement).
 pub const MAG_WRITE_LOG_LEN: usize = 32;
@@ -91,9 +92,44 @@ impl Magnetometer for Qmc5883l {
     }
 }
 
-/// Implements [`SpiTarget`] (not driven) and [`Chip`] for a [`Magnetometer`].
+/// Implements [`I2cTarget`] (the shared register-pointer front end, every data byte logged),
+/// [`SpiTarget`] (not driven) and [`Chip`] for a [`Magnetometer`].
 macro_rules! magnetometer_chip {
     ($chip:ty) => {
+        impl I2cTarget for $chip {
+            fn start(&mut self, address: u8, read: bool) -> bool {
+                let addressed = address == self.address();
+                self.bus.start(addressed, read)
+            }
+            fn write(&mut self, byte: u8) -> bool {
+                match self.bus.write(byte) {
+                    Step::Pointer(addr) => self.set_pointer(addr),
+                    Step::Data(value) => {
+                        let register = self.write_next(value);
+                        let device = self.address();
+                        self.log.push(RegisterWrite {
+                            bus: Bus::I2c,
+                            device,
+                            register,
+                            value,
+                        });
+                    }
+                    Step::Ignored => return false,
+                }
+                true
+            }
+            fn read(&mut self) -> u8 {
+                if self.bus.may_read() {
+                    self.read_next()
+                } else {
+                    0xFF
+                }
+            }
+            fn stop(&mut self) {
+                self.bus.stop();
+            }
+        }
+
         impl SpiTarget for $chip {
             fn select(&mut self) -> u8 {
                 0x00
