@@ -18,6 +18,7 @@
 
 use margemu_sim::scene::rig::Device;
 use margemu_sim::truth::Truth;
+use nalgebra::Vector3;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -31,16 +32,8 @@ pub const DEVICE_TRUTH_COLUMNS: &str = "t_ns,device,wx,wy,wz,fx,fy,fz,dwx,dwy,dw
 /// The specific force at a point `r` (m) of a rigid body whose reference point feels `f`,
 /// turning at `w` with angular acceleration `dw` (all in one frame).
 pub fn at_point(f: [f64; 3], w: [f64; 3], dw: [f64; 3], r: [f64; 3]) -> [f64; 3] {
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let tangential = cross(dw, r);
-    let centripetal = cross(w, cross(w, r));
-    [0, 1, 2].map(|i| f[i] + tangential[i] + centripetal[i])
+    let [f, w, dw, r] = [f, w, dw, r].map(Vector3::from);
+    (f + dw.cross(&r) + w.cross(&w.cross(&r))).into()
 }
 
 /// The open `device_truth.csv` of a rig.
