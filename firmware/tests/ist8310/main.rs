@@ -14,15 +14,14 @@ mod transactions;
 
 pub use transactions::*;
 
-use margemu_firmware::chip::{I2cTarget, Ist8310};
+use margemu_firmware::chip::{Chip, I2cTarget, Ist8310};
 
 pub const MS: u64 = 1_000_000;
 pub const ADDRESS: u8 = 0x0E;
 
 /// The device loop: moves the chip's clock to `now_ns` without a new sample (the held field).
 pub fn tick(mag: &mut Ist8310, now_ns: u64) {
-    let held = mag.held();
-    mag.sense_at(now_ns, held);
+    Chip::advance(mag, now_ns);
 }
 
 /// One register write over I2C, every byte acknowledged.
