@@ -68,6 +68,20 @@ pub enum Error {
     },
     /// The FFT length is too large to plan (its Bluestein length overflows `usize`).
     FftTooLong,
+    /// More vibration sources, harmonics or shocks than a sensor holds.
+    TooManyVibrationSources,
+    /// Random vibration is given for the gyroscope (it is linear acceleration only).
+    RandomVibrationNotLinear,
+    /// A tone source has no motor or more than [`crate::vibration::MAX_MOTORS`].
+    InvalidMotorCount,
+    /// An rpm profile is empty or its instants go backwards.
+    InvalidRpmProfile,
+    /// A PSD has fewer than 2 or more than [`crate::vibration::MAX_PSD_POINTS`] breakpoints, or
+    /// its frequencies do not increase.
+    InvalidPsd,
+    /// A PSD's lowest breakpoint is too low for the internal rate (the synthesis block would
+    /// exceed [`crate::vibration::random::MAX_FFT_LEN`] samples).
+    PsdTooFine,
 }
 
 impl fmt::Display for Error {
@@ -104,6 +118,36 @@ impl fmt::Display for Error {
                 write!(f, "buffer holds {got} elements, {needed} are needed")
             }
             Error::FftTooLong => f.write_str("FFT length too large to plan"),
+            Error::TooManyVibrationSources => write!(
+                f,
+                "too many vibration sources for one sensor (at most {} tone sources of {} \
+                 harmonics, {} shocks, one random source)",
+                crate::vibration::MAX_TONE_SOURCES,
+                crate::vibration::MAX_HARMONICS,
+                crate::vibration::MAX_SHOCKS
+            ),
+            Error::RandomVibrationNotLinear => {
+                f.write_str("random vibration is linear acceleration only")
+            }
+            Error::InvalidMotorCount => write!(
+                f,
+                "a tone source needs 1 to {} motors",
+                crate::vibration::MAX_MOTORS
+            ),
+            Error::InvalidRpmProfile => {
+                f.write_str("an rpm profile needs at least one point, in time order")
+            }
+            Error::InvalidPsd => write!(
+                f,
+                "a PSD needs 2 to {} breakpoints with increasing frequencies",
+                crate::vibration::MAX_PSD_POINTS
+            ),
+            Error::PsdTooFine => write!(
+                f,
+                "the PSD's lowest breakpoint is too low for the internal rate (synthesis block \
+                 over {} samples)",
+                crate::vibration::random::MAX_FFT_LEN
+            ),
         }
     }
 }

@@ -2,6 +2,7 @@
 #![no_std]
 #![warn(missing_docs)]
 
+pub mod chain;
 pub mod error;
 pub mod noise;
 pub mod perturbation;
@@ -9,5 +10,6 @@ pub mod rng;
 pub mod sensor;
 pub mod time;
 pub mod vec3;
+pub mod vibration;
 
 pub use error::Error;

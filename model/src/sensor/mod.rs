@@ -80,6 +80,11 @@ pub struct Sample {
     pub mag: Vec3,
 }
 
+/// `v` finite and rounded to `f32` (refused if a component is NaN, infinite or overflows).
+pub(crate) fn vec_f32_checked(v: [f64; 3], what: &'static str) -> Result<Vec3, Error> {
+    vec_f32(each3(v, what, finite)?, what)
+}
+
 fn check_rate(rate_hz: f64) -> Result<f64, Error> {
     if rate_hz.is_finite() && rate_hz > 0.0 {
         Ok(rate_hz)

@@ -28,6 +28,7 @@ pub mod rig;
 mod schema;
 pub mod sensors;
 pub mod size;
+pub mod vibration;
 mod validate;
 mod warnings;
 
@@ -60,6 +61,11 @@ pub struct Scene {
     pub chip_name: String,
     /// The rig's other devices (`[[device]]` after the first), in order ([`rig`]).
     pub other_devices: Vec<rig::Device>,
+    /// The vibration reaching each device, in [`Scene::devices`]' order (empty entries when the
+    /// scene has no `[vibration]`).
+    pub vibration: Vec<vibration::DeviceVibration>,
+    /// Where the devices' sampling chains run (`[vibration] path`).
+    pub sampling: vibration::SamplingPath,
     /// Legal but likely wrong inputs, located (commands print them once, to stderr).
     pub warnings: Vec<SceneWarning>,
 }
@@ -95,6 +101,8 @@ impl Scene {
             chip: checked.primary.chip,
             chip_name: checked.primary.name,
             other_devices: checked.others,
+            vibration: Vec::new(),
+            sampling: vibration::SamplingPath::Auto,
             warnings,
         };
         scene.check_gains()?;
