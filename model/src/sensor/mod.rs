@@ -267,6 +267,32 @@ impl Marg {
         }
     }
 
+    /// One sample with the accelerometer's specific force at the sensor and the gyroscope's
+    /// rate given: what a sampling chain ([`crate::chain`]) made of the truth's. The field, the
+    /// temperature and (for the g-sensitivity) nothing else come from `truth`.
+    #[inline]
+    pub fn sample_chained(
+        &mut self,
+        truth: &Truth,
+        specific_force_at_sensor: Vec3,
+        angular_rate: Vec3,
+    ) -> Sample {
+        if self.ideal {
+            return Sample {
+                acc: specific_force_at_sensor,
+                gyr: angular_rate,
+                mag: truth.magnetic_field,
+            };
+        }
+        let t = truth.temperature_c;
+        let f = specific_force_at_sensor;
+        Sample {
+            acc: self.accel.sample(f, t),
+            gyr: self.gyro.sample(angular_rate, f, t),
+            mag: self.mag.sample(truth.magnetic_field, t),
+        }
+    }
+
     /// The gyroscope.
     pub fn gyro(&self) -> &Gyro {
         &self.gyro

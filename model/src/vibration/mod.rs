@@ -5,7 +5,8 @@
 //! accelerometer: m/s² added to the specific force; [`Sense::Angular`] for the gyroscope: rad/s
 //! added to the body rate) at that sensor's internal sample period, from the sources that reach
 //! the device, with their amplitudes already in the device's axes. [`Vibration::next`] gives the
-//! vibration at the next internal instant `k · period`, in order from `k = 0`.
+//! vibration at the next internal instant (instants `k · period` from `k = 0`, or the output
+//! instants on the output path); tone phases advance one period per call.
 //!
 //! - **Motor tones** ([`ToneSource`]): `motors` motors follow one rpm profile (piecewise linear in
 //!   time: constant, ramp, steps or a recorded table), each motor's rpm scaled by its own factor
@@ -25,11 +26,11 @@
 //! ```
 //! use margemu_model::vibration::{Harmonic, RpmPoint, Sense, ToneSource, Vibration};
 //! let profile = [RpmPoint { t_ns: 0, rpm: 12_000.0 }]; // 200 Hz
-//! let mut tone = ToneSource::new(1, &profile);
+//! let mut tone = ToneSource::new(1, &profile[..]);
 //! tone.push(Harmonic { order: 1.0, linear: [0.0, 0.0, 5.0], angular: [0.0; 3] })?;
 //! let mut vib = Vibration::<&[RpmPoint], Vec<_>>::new(Sense::Linear, 125_000, 7);
 //! vib.add_tones(tone)?;
-//! let peak = (0..8000).map(|_| vib.next()[2].abs()).fold(0.0f32, f32::max);
+//! let peak = (0..8000u64).map(|k| vib.next(k * 125_000)[2].abs()).fold(0.0f32, f32::max);
 //! assert!((peak - 5.0).abs() < 0.01);
 //! # Ok::<(), margemu_model::Error>(())
 //! ```
@@ -86,8 +87,6 @@ pub struct Vibration<P, B> {
     shocks: [(u64, u64, [f32; 3]); MAX_SHOCKS],
     shock_count: usize,
     random: Option<Random<B>>,
-    /// Index of the next internal sample.
-    k: u64,
 }
 
 impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> Vibration<P, B> {
@@ -101,7 +100,6 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> Vibration<P, 
             shocks: [(0, 0, [0.0; 3]); MAX_SHOCKS],
             shock_count: 0,
             random: None,
-            k: 0,
         }
     }
 
@@ -155,11 +153,9 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> Vibration<P, 
         self.tones.iter().all(Option::is_none) && self.shock_count == 0 && self.random.is_none()
     }
 
-    /// The vibration at the next internal instant.
+    /// The vibration at `t_ns`, the next instant (one period after the previous call's).
     #[inline]
-    pub fn next(&mut self) -> Vec3 {
-        let t_ns = self.k.saturating_mul(self.period_ns);
-        self.k += 1;
+    pub fn next(&mut self, t_ns: u64) -> Vec3 {
         let mut v = [0.0f32; 3];
         for tones in self.tones.iter_mut().flatten() {
             v = add(v, tones.next(t_ns));
