@@ -82,6 +82,8 @@ pub enum Error {
     /// A PSD's lowest breakpoint is too low for the internal rate (the synthesis block would
     /// exceed [`crate::vibration::random::MAX_FFT_LEN`] samples).
     PsdTooFine,
+    /// A chip's sampling chain cannot be built for its configuration (a scene check missed it).
+    ChainRefused,
 }
 
 impl fmt::Display for Error {
@@ -142,6 +144,9 @@ impl fmt::Display for Error {
                 "a PSD needs 2 to {} breakpoints with increasing frequencies",
                 crate::vibration::MAX_PSD_POINTS
             ),
+            Error::ChainRefused => {
+                f.write_str("the chip's sampling chain cannot be built for its configuration")
+            }
             Error::PsdTooFine => write!(
                 f,
                 "the PSD's lowest breakpoint is too low for the internal rate (synthesis block \

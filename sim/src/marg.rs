@@ -2,13 +2,18 @@
 //! will drive it, so the host predicts every sample the device emits bit for bit.
 //!
 //! Per output sample the body-frame truth is rounded to `f32`, the magnetic disturbance of the
-//! perturbation generator (if the scene has one) is added to the true field, and the sensor
-//! model of eq. 18 turns that into accelerometer, gyroscope and magnetometer readings.
+//! perturbation generator (if the scene has one) is added to the true field, the specific force
+//! and the body rate go through the device's sampling chain (vibration, front-end clipping,
+//! the chip's filters: [`crate::sampling`]), and the sensor model of eq. 18 turns that into
+//! accelerometer, gyroscope and magnetometer readings.
 //!
 //! `marg.csv`: `t_ns,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z` in m/s², rad/s and
 //! the scene's field unit. `perturbation.csv`: `t_ns,mag_x,mag_y,mag_z`, the disturbance added
 //! to the true field per axis (written only when the scene has a `[perturbation]`).
 
+use crate::sampling::HostChain;
+use crate::scene::chip::ChipSetup;
+use crate::scene::vibration::DeviceVibration;
 use crate::scene::Scene;
 use crate::truth::Truth;
 use margemu_model::perturbation::{Complex, Perturbation, PerturbationPlan};
@@ -45,6 +50,17 @@ pub struct MargSim {
     produced: u64,
     perturbation: Option<HostPerturbation>,
     temperature: Option<[f64; 2]>,
+    chain: Option<HostChain>,
+}
+
+/// Front-end clipping so far: internal samples (or output samples, on the output path) that
+/// clipped, per axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ClipCounts {
+    /// Accelerometer x, y, z.
+    pub accel: [u64; 3],
+    /// Gyroscope x, y, z.
+    pub gyro: [u64; 3],
 }
 
 /// One output sample of the sensor model.
@@ -70,7 +86,14 @@ impl MargSample {
 impl MargSim {
     /// The model of `scene` (already validated, so this fails only on a model it refused).
     pub fn new(scene: &Scene) -> Result<Self, margemu_model::Error> {
-        Self::build(scene, &scene.spec.sensors.config(), scene.spec.seed)
+        let vibration = scene.vibration.first().cloned().unwrap_or_default();
+        let vibration = crate::sampling::in_plate_axes(&vibration, &scene.chip);
+        Self::build(
+            scene,
+            &scene.spec.sensors.config(),
+            scene.spec.seed,
+            (&scene.chip, &vibration),
+        )
     }
 
     /// The model of device `index` of `scene`'s rig ([`Scene::devices`]): the scene's sensor
@@ -86,10 +109,12 @@ impl MargSim {
             let base = config.accel.lever_arm_m.unwrap_or([0.0; 3]);
             config.accel.lever_arm_m = Some([0, 1, 2].map(|i| base[i] + r[i]));
         }
+        let vibration = scene.vibration.get(index).cloned().unwrap_or_default();
         Some(Self::build(
             scene,
             &config,
             device_seed(scene.spec.seed, index),
+            (&device.chip, &vibration),
         ))
     }
 
@@ -97,7 +122,9 @@ impl MargSim {
         scene: &Scene,
         config: &sensor::MargConfig,
         seed: u64,
+        (chip, vibration): (&ChipSetup, &DeviceVibration),
     ) -> Result<Self, margemu_model::Error> {
+        let chain = crate::sampling::build(scene, chip, vibration, seed).transpose()?;
         let spec = &scene.spec;
         let rate = scene.clock.hz();
         let marg = Marg::new(config, rate, seed)?;
@@ -115,7 +142,21 @@ impl MargSim {
             produced: 0,
             perturbation,
             temperature: spec.sensors.temperature,
+            chain,
         })
+    }
+
+    /// Front-end clipping so far (`None` for a device without accelerometer and gyroscope).
+    pub fn clips(&self) -> Option<ClipCounts> {
+        self.chain.as_ref().map(|c| ClipCounts {
+            accel: c.accel.clips(),
+            gyro: c.gyro.clips(),
+        })
+    }
+
+    /// Whether the device's chain runs at the chip's internal rate.
+    pub fn runs_internal_path(&self) -> bool {
+        self.chain.as_ref().is_some_and(|c| c.accel.period_ns() != 0)
     }
 
     /// Whether the scene has a perturbation generator.
@@ -154,9 +195,13 @@ impl MargSim {
                 .temperature
                 .map(|[start, slope]| (start + slope * t.t_ns as f64 * 1e-9) as f32),
         };
+        let sample = match self.chain.as_mut() {
+            Some(chain) => chain.sample(&mut self.marg, t.t_ns, &truth),
+            None => self.marg.sample(&truth),
+        };
         MargSample {
             t_ns: t.t_ns,
-            sample: self.marg.sample(&truth),
+            sample,
             disturbance,
         }
     }

@@ -103,9 +103,13 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> Vibration<P, 
         }
     }
 
-    /// Adds a tone source (its amplitudes of this sensor's sense); refuses a
-    /// [`MAX_TONE_SOURCES`]-th + 1 or an invalid profile.
+    /// Adds a tone source (its amplitudes of this sensor's sense; a source without any is
+    /// checked and left out, costing nothing); refuses a [`MAX_TONE_SOURCES`]-th + 1 or an
+    /// invalid profile.
     pub fn add_tones(&mut self, source: ToneSource<P>) -> Result<(), Error> {
+        if !source.moves(self.sense) {
+            return Tones::new(source, self.sense, self.period_ns, self.seed, 0).map(|_| ());
+        }
         let index = self.tones.iter().position(Option::is_none);
         let index = index.ok_or(Error::TooManyVibrationSources)?;
         let tones = Tones::new(source, self.sense, self.period_ns, self.seed, index)?;
@@ -127,6 +131,9 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> Vibration<P, 
             Sense::Angular => shock.angular,
         };
         let peak = crate::sensor::vec_f32_checked(peak, "vibration.shock.peak")?;
+        if peak == [0.0; 3] {
+            return Ok(());
+        }
         let slot = self.shocks.get_mut(self.shock_count);
         let slot = slot.ok_or(Error::TooManyVibrationSources)?;
         *slot = (shock.t_ns, shock.duration_ns, peak);

@@ -65,6 +65,22 @@ impl<P: AsRef<[RpmPoint]>> ToneSource<P> {
         Ok(())
     }
 
+    /// Changes every harmonic with `f` (e.g. to turn its amplitudes into other axes).
+    pub fn map_harmonics(&mut self, mut f: impl FnMut(&mut Harmonic)) {
+        self.harmonics.iter_mut().take(self.harmonic_count).for_each(|h| f(h));
+    }
+
+    /// Whether some harmonic has an amplitude in `sense`.
+    pub fn moves(&self, sense: Sense) -> bool {
+        self.harmonics().iter().any(|h| {
+            let a = match sense {
+                Sense::Linear => h.linear,
+                Sense::Angular => h.angular,
+            };
+            a != [0.0; 3]
+        })
+    }
+
     /// The harmonics.
     pub fn harmonics(&self) -> &[Harmonic] {
         self.harmonics.get(..self.harmonic_count).unwrap_or(&[])

@@ -1,0 +1,128 @@
+//! Each device's sampling chain on the host: which path runs ([`SamplingPath`]) and what it is
+//! built from (the chip's declared chain, the vibration reaching the device, its seed).
+//!
+//! - An IMU device always has a chain. On the **output path** (the default when nothing reaching
+//!   the device vibrates above the output Nyquist frequency) it adds the vibration at the output
+//!   instants and clips and counts at the chip's full scale: a few comparisons per sample.
+//! - On the **internal path** it runs the chip's internal rate, front-end clipping, filters and
+//!   decimation ([`margemu_protocol::chip::chain`]): the cost grows with the internal rate.
+//! - A magnetometer-only device has none (vibration does not reach a magnetometer's reading).
+//!
+//! The firmware builds the very same [`DeviceChain`] in source mode (b), so both give the same
+//! bits.
+
+use crate::scene::chip::ChipSetup;
+use crate::scene::vibration::{DeviceVibration, SamplingPath};
+use crate::scene::Scene;
+use margemu_model::chain::{DeviceChain, SensorPath};
+use margemu_model::perturbation::Complex;
+use margemu_model::vibration::{RpmPoint, Sense, Vibration};
+use margemu_model::Error;
+use margemu_protocol::chip::chain::ChipChain;
+
+/// A device's chain with host-owned buffers.
+pub type HostChain = DeviceChain<Vec<RpmPoint>, Vec<Complex>>;
+/// One sensor's path with host-owned buffers.
+pub type HostPath = SensorPath<Vec<RpmPoint>, Vec<Complex>>;
+/// One sensor's vibration with host-owned buffers.
+pub type HostVibration = Vibration<Vec<RpmPoint>, Vec<Complex>>;
+
+/// Whether `vibration` on a device of `scene` takes the internal path.
+pub fn uses_internal_path(scene: &Scene, vibration: &DeviceVibration) -> bool {
+    match scene.sampling {
+        SamplingPath::Internal => true,
+        SamplingPath::Output => false,
+        SamplingPath::Auto => vibration.max_frequency_hz() > 0.5 * scene.clock.hz(),
+    }
+}
+
+/// The chip's declared chain at the scene's output rate (`None` for a magnetometer).
+pub fn chip_chain(scene: &Scene, chip: &ChipSetup) -> Option<Result<ChipChain, Error>> {
+    let config = chip.chain.as_ref()?;
+    Some(
+        ChipChain::new(&chip.settings, config, scene.spec.rate_fraction())
+            .map_err(|_| Error::ChainRefused),
+    )
+}
+
+/// The chain of a device mounted as `chip`, with `vibration` reaching it (chip axes) and the
+/// device's seed; `None` for a magnetometer-only device.
+pub fn build(
+    scene: &Scene,
+    chip: &ChipSetup,
+    vibration: &DeviceVibration,
+    seed: u64,
+) -> Option<Result<HostChain, Error>> {
+    let declared = match chip_chain(scene, chip)? {
+        Ok(c) => c,
+        Err(e) => return Some(Err(e)),
+    };
+    let internal = uses_internal_path(scene, vibration);
+    let output_period = libm_round(1e9 / scene.clock.hz());
+    let path = |sense: Sense, spec: &margemu_protocol::chip::chain::SensorChain| {
+        if internal {
+            let vib = sensor_vibration(sense, spec.period_ns, seed, vibration)?;
+            SensorPath::new(spec.period_ns, spec.filter, spec.range, vib)
+        } else {
+            let vib = sensor_vibration(sense, output_period, seed, vibration)?;
+            SensorPath::at_output(spec.range, vib)
+        }
+    };
+    Some((|| {
+        Ok(DeviceChain {
+            accel: path(Sense::Linear, &declared.accel)?,
+            gyro: path(Sense::Angular, &declared.gyro)?,
+        })
+    })())
+}
+
+fn libm_round(x: f64) -> u64 {
+    x.round().max(1.0) as u64
+}
+
+/// The vibration one sensor sees, sampled every `period_ns`.
+pub fn sensor_vibration(
+    sense: Sense,
+    period_ns: u64,
+    seed: u64,
+    vibration: &DeviceVibration,
+) -> Result<HostVibration, Error> {
+    let mut vib = Vibration::new(sense, period_ns, seed);
+    for tones in &vibration.tones {
+        vib.add_tones(tones.clone())?;
+    }
+    for shock in &vibration.shocks {
+        vib.add_shock(shock)?;
+    }
+    if let (Sense::Linear, Some(random)) = (sense, &vibration.random) {
+        let len = random.buffer_len(1e9 / period_ns as f64)?;
+        vib.add_random(random, vec![Complex::ZERO; len])?;
+    }
+    Ok(vib)
+}
+
+/// `vibration` (in the axes of a chip mounted as `chip`) back in plate axes: what a model that
+/// works in plate axes (`margemu simulate`) adds.
+pub fn in_plate_axes(vibration: &DeviceVibration, chip: &ChipSetup) -> DeviceVibration {
+    let Some(r) = chip.rotation else {
+        return vibration.clone();
+    };
+    let back = |v: [f64; 3]| -> [f64; 3] {
+        core::array::from_fn(|i| r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2])
+    };
+    let mut out = vibration.clone();
+    for tones in &mut out.tones {
+        tones.map_harmonics(|h| {
+            h.linear = back(h.linear);
+            h.angular = back(h.angular);
+        });
+    }
+    for shock in &mut out.shocks {
+        shock.linear = back(shock.linear);
+        shock.angular = back(shock.angular);
+    }
+    if let Some(random) = &mut out.random {
+        random.axes = None;
+    }
+    out
+}
