@@ -8,12 +8,15 @@
 //! - [`link`]: the device side of the host link: frames in through the shared accumulator,
 //!   samples (register images, or kinematics through the shared model) swapped into the chip at
 //!   each sample instant, credits, telemetry and register writes out.
+//! - [`chain_bench`]: the sampling-chain benchmark cases the host and the Cortex-M4F both run
+//!   (bit-identity and cost of `margemu_model::chain`).
 //! - [`spi_shadow`]: for boards whose SPI target cannot answer the address byte in time: the
 //!   register file served from a shadow with a speculative burst preload, every transaction
 //!   replayed into the chip and checked.
 #![no_std]
 #![warn(missing_docs)]
 
+pub mod chain_bench;
 pub mod chip;
 pub mod link;
 pub mod spi_shadow;
