@@ -3,7 +3,8 @@
 //! scripted link host for either source mode; [`model_source`] prepares a scene for source
 //! mode (b) and predicts its images; [`served`] checks the device's Served reports against a
 //! prediction; [`qemu_session`] runs and checks one QEMU session of either source mode;
-//! [`qemu_chip`] runs a chip model on the QEMU board in both.
+//! [`qemu_chip`] runs a chip model on the QEMU board in both; [`qemu_chain`] runs the
+//! sampling-chain benchmark on it and tabulates its cost.
 
 use std::path::{Path, PathBuf};
 
@@ -12,6 +13,7 @@ use margemu::scene::Scene;
 pub mod drive;
 pub mod model_source;
 pub mod qemu;
+pub mod qemu_chain;
 pub mod qemu_chip;
 pub mod qemu_session;
 pub mod served;

@@ -13,6 +13,8 @@ use crate::workspace_root;
 pub const BOARD: &str = "qemu-mps2-an386";
 /// The board binary's name (its package name).
 pub const BOARD_BIN: &str = "margemu-board-qemu-mps2-an386";
+/// The board crate's sampling-chain benchmark binary (`src/bin/chain_bench.rs`).
+pub const CHAIN_BENCH_BIN: &str = "chain-bench";
 /// The Cortex-M4F target the board builds for.
 pub const CROSS_TARGET: &str = "thumbv7em-none-eabihf";
 
@@ -130,9 +132,27 @@ pub fn board_elf() -> io::Result<PathBuf> {
         .map_err(io::Error::other)
 }
 
+/// The chain-bench ELF, built once per test process (release profile, the same build as
+/// [`board_elf`]'s: cargo builds every binary of the board crate).
+pub fn chain_bench_elf() -> io::Result<PathBuf> {
+    static ELF: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    ELF.get_or_init(|| {
+        build_board_bin(&board_dir(), &board_target_dir(), CHAIN_BENCH_BIN)
+            .map_err(|e| e.to_string())
+    })
+    .clone()
+    .map_err(io::Error::other)
+}
+
 /// Cross-builds the board crate in `board` (release) into `target_dir` and returns its ELF.
 /// Cargo runs in the board's folder so its `.cargo/config.toml` (target, linker) applies.
 pub fn build_board(board: &Path, target_dir: &Path) -> io::Result<PathBuf> {
+    build_board_bin(board, target_dir, BOARD_BIN)
+}
+
+/// Cross-builds the board crate in `board` (release, every binary) into `target_dir` and
+/// returns the ELF of its binary `bin`.
+pub fn build_board_bin(board: &Path, target_dir: &Path, bin: &str) -> io::Result<PathBuf> {
     let toolchain = cross_toolchain()?;
     let mut cmd = match toolchain {
         CrossToolchain::Rustup => {
@@ -169,10 +189,7 @@ pub fn build_board(board: &Path, target_dir: &Path) -> io::Result<PathBuf> {
             String::from_utf8_lossy(&out.stderr)
         )));
     }
-    let elf = target_dir
-        .join(CROSS_TARGET)
-        .join("release")
-        .join(BOARD_BIN);
+    let elf = target_dir.join(CROSS_TARGET).join("release").join(bin);
     if !elf.is_file() {
         return Err(not_found(format!(
             "built, but {} is missing",

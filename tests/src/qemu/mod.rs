@@ -26,9 +26,11 @@
 //! into `target/thumbv7em` (or `$MARGEMU_BOARD_TARGET_DIR`).
 
 mod build;
+mod semihosting;
 mod serial;
 
 pub use build::*;
+pub use semihosting::run_to_exit;
 pub(crate) use serial::is_transient;
 pub use serial::{LinkDecoder, SerialLink};
 
