@@ -2,6 +2,7 @@
 #![no_std]
 #![warn(missing_docs)]
 
+pub mod chain;
 pub mod error;
 pub mod noise;
 pub mod perturbation;
