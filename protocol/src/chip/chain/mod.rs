@@ -234,13 +234,10 @@ impl ChipChain {
     }
 }
 
-/// The exact period of `rate` in ns; 0 if it is not a whole number of ns (no chip gives one).
+/// The period of `rate` in ns, rounded to the nearest ns (a scene's 1000/3 Hz given in mHz
+/// still finds the chip's 3 ms); 0 for a rate above 2 GHz.
 fn period_of(rate: Rate) -> u64 {
     let num = u128::from(rate.num());
     let ns = u128::from(rate.den()) * 1_000_000_000;
-    if num != 0 && ns % num == 0 {
-        u64::try_from(ns / num).unwrap_or(0)
-    } else {
-        0
-    }
+    u64::try_from((ns + num / 2) / num.max(1)).unwrap_or(0)
 }
