@@ -28,8 +28,8 @@ pub mod rig;
 mod schema;
 pub mod sensors;
 pub mod size;
-pub mod vibration;
 mod validate;
+pub mod vibration;
 mod warnings;
 
 pub use error::{SceneError, SceneWarning};
@@ -91,7 +91,7 @@ impl Scene {
             .into_iter()
             .map(|v| SceneWarning(SceneError::from_violation(path, text, v)))
             .collect();
-        let scene = Self {
+        let mut scene = Self {
             spec,
             path: path.to_path_buf(),
             text: text.to_owned(),
@@ -106,6 +106,12 @@ impl Scene {
             warnings,
         };
         scene.check_gains()?;
+        let devices = scene.devices();
+        let spec = &scene.spec;
+        scene.vibration =
+            vibration::resolve(&spec.vibration, &devices, spec.rate, scene.base_dir())
+                .map_err(|v| SceneError::from_violation(path, text, v))?;
+        scene.sampling = scene.spec.vibration.path;
         Ok(scene)
     }
 

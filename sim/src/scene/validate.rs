@@ -344,7 +344,7 @@ pub(crate) fn finite(x: f64, at: &[&str], range: Plausible) -> Check {
     }
 }
 
-fn finite_positive(x: f64, at: &[&str], range: Plausible) -> Check {
+pub(crate) fn finite_positive(x: f64, at: &[&str], range: Plausible) -> Check {
     if x.is_finite() && x > 0.0 {
         range.check(x, at)
     } else {
