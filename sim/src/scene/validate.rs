@@ -324,7 +324,7 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
     }
 }
 
-fn positive_nanos(s: f64, at: &[&str], range: Plausible) -> Result<Nanos, Violation> {
+pub(crate) fn positive_nanos(s: f64, at: &[&str], range: Plausible) -> Result<Nanos, Violation> {
     finite_positive(s, at, range)?;
     match nanos_from_seconds(s) {
         Some(ns) if ns > 0 => Ok(ns),

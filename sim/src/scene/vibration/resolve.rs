@@ -293,12 +293,8 @@ impl At {
 /// A shock in plate axes.
 fn shock_of(shock: &ShockSpec, at: &At) -> Result<Shock, Violation> {
     let t_ns = instant(shock.at, &at.key("at"))?;
-    let d_at = at.key("duration");
-    d_at.check(validate::finite_positive(shock.duration, &[], ranges::TIME))?;
-    let duration_ns = instant(shock.duration, &d_at)?;
-    if duration_ns == 0 {
-        return Err(d_at.error(format!("must be at least 1 ns, not {} s", shock.duration)));
-    }
+    let duration_ns = validate::positive_nanos(shock.duration, &[], ranges::TIME)
+        .map_err(|v| at.key("duration").error(v.reason))?;
     at.key("linear")
         .vector(&shock.linear, ranges::VIBRATION_LINEAR)?;
     at.key("angular")
