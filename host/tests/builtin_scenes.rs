@@ -80,7 +80,7 @@ fn scenes_lists_every_fixture_scene_and_prints_its_text() {
     let (out, text) = margemu_in(&dir, &["scenes"]);
     assert!(out.status.success(), "{text}");
     let fixtures = fixtures();
-    assert_eq!(fixtures.len(), 8);
+    assert_eq!(fixtures.len(), 9);
     for (name, source) in &fixtures {
         let scene = Scene::parse_str(source, Path::new(name)).unwrap();
         let line = text

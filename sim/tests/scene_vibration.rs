@@ -540,3 +540,28 @@ fn csv_problems_name_the_csv_line() {
     assert!(e.contains(&at), "{e}");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn late_shocks_and_aliasing_on_the_output_path_are_warned_about() {
+    let text = format!(
+        "{BASE}[vibration]\npath = \"output\"\n[[vibration.shocks]]\nat = 1.0\nduration = 0.001\n"
+    );
+    let scene = parse(&text);
+    let warnings: Vec<String> = scene.warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        warnings,
+        [
+            "scenes/v.toml:8:6: `vibration.shocks[0].at`: the shock starts at 1 s, not before \
+             the run ends (1 s): it never happens",
+            "scenes/v.toml:6:8: `vibration.path`: vibration reaches above the output Nyquist \
+             frequency 500 Hz (`mpu9250` up to 1500 Hz): on the output path the samples alias it",
+        ]
+    );
+    // The same content on the automatic path, starting within the run: nothing to warn about.
+    let fine = parse(
+        &text
+            .replace("output", "auto")
+            .replace("at = 1.0", "at = 0.5"),
+    );
+    assert!(fine.warnings.is_empty(), "{:?}", fine.warnings);
+}

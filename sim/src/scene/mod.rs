@@ -106,13 +106,34 @@ impl Scene {
             warnings,
         };
         scene.check_gains()?;
-        let devices = scene.devices();
-        let spec = &scene.spec;
-        scene.vibration =
-            vibration::resolve(&spec.vibration, &devices, spec.rate, scene.base_dir())
-                .map_err(|v| SceneError::from_violation(path, text, v))?;
-        scene.sampling = scene.spec.vibration.path;
+        scene.resolve_vibration()?;
         Ok(scene)
+    }
+
+    /// Fills [`Scene::vibration`] and [`Scene::sampling`] from `[vibration]`, and adds its
+    /// warnings.
+    fn resolve_vibration(&mut self) -> Result<(), SceneError> {
+        let devices = self.devices();
+        let (spec, located) = (&self.spec, |v| {
+            SceneError::from_violation(&self.path, &self.text, v)
+        });
+        let per_device = vibration::resolve(&spec.vibration, &devices, spec.rate, self.base_dir())
+            .map_err(located)?;
+        let warnings = vibration::warnings(
+            &spec.vibration,
+            &devices,
+            &per_device,
+            spec.rate,
+            spec.duration,
+        );
+        let warnings: Vec<_> = warnings
+            .into_iter()
+            .map(|v| SceneWarning(located(v)))
+            .collect();
+        self.sampling = spec.vibration.path;
+        self.vibration = per_device;
+        self.warnings.extend(warnings);
+        Ok(())
     }
 
     /// Every device of the scene's rig, device 0 ([`Scene::chip`]) first.

@@ -24,10 +24,12 @@
 mod resolve;
 mod rpm;
 mod spec;
+mod warn;
 
 pub(crate) use resolve::resolve;
 pub use resolve::CHECK_RATE_HZ;
 pub use spec::{HarmonicSpec, RampSpec, RandomSpec, ShockSpec, ToneSpec, VibrationSpec};
+pub(crate) use warn::collect as warnings;
 
 use margemu_model::vibration::{RandomSource, RpmPoint, Shock, ToneSource};
 
