@@ -21,6 +21,7 @@
 //! assert_eq!(tone.max_frequency_hz(), 200.0);
 //! ```
 
+mod at;
 mod resolve;
 mod rpm;
 mod spec;

@@ -1,11 +1,12 @@
 //! Resolution of `[vibration]`: each source checked, routed to the devices it reaches and turned
 //! into their chip axes; then each device's set checked by the model itself.
 
+use super::at::At;
 use super::rpm::{instant, profile};
 use super::spec::{RandomSpec, ShockSpec, ToneSpec, VibrationSpec};
 use super::DeviceVibration;
-use crate::scene::error::{PathPart, Violation};
-use crate::scene::ranges::{self, Plausible};
+use crate::scene::error::Violation;
+use crate::scene::ranges;
 use crate::scene::rig::Device;
 use crate::scene::validate;
 use margemu_model::perturbation::Complex;
@@ -20,55 +21,6 @@ use std::path::Path;
 pub const CHECK_RATE_HZ: f64 = 32_000.0;
 
 type Check = Result<(), Violation>;
-
-/// A key path in the scene, for locating refusals.
-#[derive(Clone, Debug)]
-pub(super) struct At(Vec<PathPart>);
-
-impl At {
-    fn root() -> Self {
-        Self(vec![PathPart::Key("vibration".to_owned())])
-    }
-
-    pub(super) fn key(&self, key: &str) -> Self {
-        let mut path = self.0.clone();
-        path.push(PathPart::Key(key.to_owned()));
-        Self(path)
-    }
-
-    pub(super) fn index(&self, i: usize) -> Self {
-        let mut path = self.0.clone();
-        path.push(PathPart::Index(i));
-        Self(path)
-    }
-
-    pub(super) fn error(&self, reason: impl Into<String>) -> Violation {
-        Violation::at_path(self.0.clone(), reason)
-    }
-
-    /// A check made without a path (`&[]`), moved here.
-    pub(super) fn check(&self, result: Check) -> Check {
-        result.map_err(|v| Violation::at_path(self.0.clone(), v.reason))
-    }
-
-    /// Each element of `xs` finite and in `range`.
-    fn vector(&self, xs: &[f64], range: Plausible) -> Check {
-        validate::all_finite(xs, &[], range).map_err(|v| self.moved(v))
-    }
-
-    /// `v` (made at an empty path, perhaps with an index) moved under this path.
-    fn moved(&self, mut v: Violation) -> Violation {
-        let mut path = self.0.clone();
-        path.append(&mut v.path);
-        v.path = path;
-        v
-    }
-
-    /// A model refusal of the source at this path.
-    fn model(&self, e: margemu_model::Error) -> Violation {
-        self.error(e.to_string())
-    }
-}
 
 /// One device's sources and where each came from.
 #[derive(Default)]
@@ -110,7 +62,7 @@ pub(crate) fn resolve(
         let source = random_source(random, &at, rate)?;
         for d in targets(random.device.as_deref(), devices, &at)? {
             let here = &mut reached[d];
-            if let Some(PathPart::Index(j)) = here.random.as_ref().and_then(|a| a.0.last()) {
+            if let Some(j) = here.random.as_ref().and_then(At::last_index) {
                 return Err(at.error(format!(
                     "device `{}` has a random source already (`vibration.random[{j}]`): at most \
                      one reaches a device",
@@ -268,7 +220,11 @@ fn random_source(random: &RandomSpec, at: &At, rate: f64) -> Result<RandomSource
         ))?;
         points.push(PsdPoint { f_hz, g2_per_hz });
     }
-    at.key("gains").vector_non_negative(&random.gains)?;
+    at.key("gains").check(validate::all_non_negative(
+        &random.gains,
+        &[],
+        ranges::VIBRATION_GAIN,
+    ))?;
     let mut source = RandomSource::new(&points).map_err(|e| psd.model(e))?;
     source.gains = random.gains;
     let check_rate = rate.max(CHECK_RATE_HZ);
@@ -281,13 +237,6 @@ fn random_source(random: &RandomSpec, at: &At, rate: f64) -> Result<RandomSource
         )));
     }
     Ok(source)
-}
-
-impl At {
-    /// Each element finite, ≥ 0 and in [`ranges::VIBRATION_GAIN`].
-    fn vector_non_negative(&self, xs: &[f64]) -> Check {
-        validate::all_non_negative(xs, &[], ranges::VIBRATION_GAIN).map_err(|v| self.moved(v))
-    }
 }
 
 /// A shock in plate axes.

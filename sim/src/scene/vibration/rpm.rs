@@ -2,7 +2,7 @@
 //! (each value held until the next step's time: a step is two points at one instant) or
 //! `rpm_csv` (rows `t_s,rpm`, linear between rows).
 
-use super::resolve::At;
+use super::at::At;
 use super::spec::{RampSpec, ToneSpec};
 use crate::csv_column::ColumnError;
 use crate::scene::error::Violation;

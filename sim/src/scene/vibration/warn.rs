@@ -1,8 +1,9 @@
 //! Vibration inputs that are legal but likely wrong: a shock that starts after the run ends,
 //! and content above the output Nyquist frequency on the output path (the samples alias it).
 
+use super::at::At;
 use super::{DeviceVibration, SamplingPath, VibrationSpec};
-use crate::scene::error::{PathPart, Violation};
+use crate::scene::error::Violation;
 use crate::scene::ranges::number;
 use crate::scene::rig::Device;
 
@@ -18,17 +19,12 @@ pub(crate) fn collect(
     let mut out = Vec::new();
     for (i, shock) in spec.shocks.iter().enumerate() {
         if shock.at >= duration {
-            let path = ["vibration", "shocks"].map(|k| PathPart::Key(k.to_owned()));
-            let mut path = path.to_vec();
-            path.extend([PathPart::Index(i), PathPart::Key("at".to_owned())]);
-            out.push(Violation::at_path(
-                path,
-                format!(
-                    "the shock starts at {} s, not before the run ends ({} s): it never happens",
-                    number(shock.at),
-                    number(duration)
-                ),
-            ));
+            let at = At::root().key("shocks").index(i).key("at");
+            out.push(at.error(format!(
+                "the shock starts at {} s, not before the run ends ({} s): it never happens",
+                number(shock.at),
+                number(duration)
+            )));
         }
     }
     let nyquist = rate / 2.0;
