@@ -94,7 +94,7 @@ impl RandomSource {
     pub fn fft_len(&self, rate_hz: f64) -> Result<usize, Error> {
         let lowest = self.points().first().map_or(1.0, |p| p.f_hz);
         let wanted = libm::ceil(16.0 * rate_hz / lowest).max(64.0);
-        if !(wanted <= MAX_FFT_LEN as f64) {
+        if wanted.is_nan() || wanted > MAX_FFT_LEN as f64 {
             return Err(Error::PsdTooFine);
         }
         let n = next_smooth(wanted as usize).ok_or(Error::PsdTooFine)?;
