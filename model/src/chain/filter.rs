@@ -48,7 +48,7 @@ use core::f64::consts::PI;
 /// Most sections (first or second order) in one design.
 pub const MAX_SECTIONS: usize = 4;
 /// Longest pure delay, in internal samples.
-pub const MAX_DELAY: usize = 64;
+pub const MAX_DELAY: usize = 160;
 /// Largest input magnitude [`FilterDesign::step`] passes on; larger finite inputs are clamped.
 pub const MAX_INPUT: f32 = 1.0e30;
 

@@ -317,8 +317,16 @@ fn mpu6xxx(
             .copied()
             .ok_or(out_of_range("dlpf_cfg", code, "0-7"))
     };
-    let gyro = row_chain(&row(gyro_table, gyro_code)?, gyro_ns)?;
-    let accel = row_chain(&row(accel_table, accel_code)?, accel_ns)?;
+    // The DLPF filters the ADC's samples before the register rate drops to 1 kHz: the gyro's at
+    // 8 kHz, the accelerometer's at 4 kHz (the rate ACCEL_FCHOICE_B exposes). The MPU-6000's
+    // accelerometer ADC rate is not documented; it stays at its 1 kHz output.
+    let gyro_filter_ns = gyro_ns.min(125_000);
+    let accel_filter_ns = match model {
+        ChipModel::Mpu6000 => accel_ns,
+        _ => accel_ns.min(250_000),
+    };
+    let gyro = row_chain(&row(gyro_table, gyro_code)?, gyro_filter_ns)?;
+    let accel = row_chain(&row(accel_table, accel_code)?, accel_filter_ns)?;
     let divides =
         (0..=255u8).any(|div| rates::sample_period_ns(variant, dlpf, fchoice_b, div) == out_ns);
     if !divides {

@@ -16,9 +16,11 @@
 //! 1.6 section 4.6 (FCHOICE_B / DLPF_CFG), DS-000176 (ICM-20602) section 10.2 table 2, and
 //! RM-MPU-6000A rev. 4.2 section 4.3 (CONFIG); accel rows from section 4.8 (A_DLPF_CFG /
 //! ACCEL_FCHOICE_B), DS-000176 table 3, and the MPU-6000's one table (its accelerometer at
-//! 1 kHz). Exact: −3 dB points and delays (except the rows below), internal rates (taken from
+//! 1 kHz). Exact: −3 dB points and delays (except the rows below), register rates (taken from
 //! [`crate::regmap::mpu6xxx::rates`], not repeated here), the SMPLRT_DIV rule for the output
-//! rate. Approximated: the filter's shape (the datasheets give only −3 dB and delay). Delays
+//! rate. The DLPF filters the ADC's samples before the register rate drops to 1 kHz, so the
+//! gyro's filter runs at 8 kHz and the accelerometer's at 4 kHz (the rate ACCEL_FCHOICE_B
+//! exposes); the MPU-6000's accelerometer ADC rate is not documented and stays at 1 kHz. Approximated: the filter's shape (the datasheets give only −3 dB and delay). Delays
 //! not met: MPU-6000 DLPF_CFG 5 and 6, gyro and accel.
 //!
 //! **ICM-42688-P** (DS-000347 rev. 1.7): both sensors sample at 32 kHz; the anti-alias filter

@@ -1,13 +1,14 @@
 //! The datasheet tables the chains are built from, one row per configuration code. Sources and
 //! what each row means are in the [parent module's docs](super).
 
-/// One row of a filter table: the configuration code, the internal rate the filter runs at, its
-/// −3 dB bandwidth and, where the datasheet gives one, its delay.
+/// One row of a filter table: the configuration code, the rate the table gives for it (the
+/// register rate; the InvenSense DLPF runs on the faster ADC samples before it, see
+/// `super::build`), its −3 dB bandwidth and, where the datasheet gives one, its delay.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Row {
     /// The register code the row is selected by (see each table).
     pub code: u8,
-    /// The internal sample period, ns.
+    /// The table's sample period, ns.
     pub period_ns: u64,
     /// The −3 dB bandwidth, Hz.
     pub bandwidth_hz: f64,
