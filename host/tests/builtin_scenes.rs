@@ -80,7 +80,7 @@ fn scenes_lists_every_fixture_scene_and_prints_its_text() {
     let (out, text) = margemu_in(&dir, &["scenes"]);
     assert!(out.status.success(), "{text}");
     let fixtures = fixtures();
-    assert_eq!(fixtures.len(), 8);
+    assert_eq!(fixtures.len(), 9);
     for (name, source) in &fixtures {
         let scene = Scene::parse_str(source, Path::new(name)).unwrap();
         let line = text
@@ -177,7 +177,8 @@ fn demo_without_a_scene_runs_the_case_study_from_an_empty_directory() {
 #[test]
 fn an_argument_that_is_neither_a_file_nor_a_built_in_scene_lists_the_names() {
     let dir = empty_dir("unknown");
-    let names = "bmi270, case-study, figure3, gimbal-lock, icm42688p, mpu6000, rig, static";
+    let names =
+        "bmi270, case-study, figure3, gimbal-lock, icm42688p, mpu6000, rig, static, vibration";
     for (arg, reason) in [
         (
             "figure4",

@@ -280,7 +280,7 @@ fn every_page_of_the_guide_is_in_the_summary() {
 
 /// Tables a scene has at its top level: a TOML block whose first header is one of these is a
 /// scene fragment.
-const SCENE_TABLES: [&str; 9] = [
+const SCENE_TABLES: [&str; 10] = [
     "integrator",
     "field",
     "bench",
@@ -290,6 +290,7 @@ const SCENE_TABLES: [&str; 9] = [
     "perturbation",
     "chip",
     "device",
+    "vibration",
 ];
 
 /// A TOML block as scene text, or `None` when it is not a scene example (see the module docs).

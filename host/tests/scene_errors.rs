@@ -513,3 +513,69 @@ fn warnings_are_located() {
     let quiet = Scene::parse_str(BASE, Path::new("q.toml")).unwrap();
     assert!(quiet.warnings.is_empty());
 }
+
+#[test]
+fn filter_errors_are_located() {
+    let chip = |body: &str| format!("{BASE}[chip]\n{body}");
+    assert_error(
+        &chip("model = \"mpu6500\"\n[chip.filters]\ngyro_aaf_delt = 6\n"),
+        "7:17",
+        "the MPU-6500 takes the filter keys dlpf_cfg, fchoice_b, a_dlpf_cfg, accel_fchoice_b",
+    );
+    assert_error(
+        &chip("model = \"mpu6500\"\n[chip.filters]\ndlpf_cfg = 0\n"),
+        "6:1",
+        "output rate 100 Hz cannot be produced with dlpf_cfg = 0 (DLPF_CFG 0 and 7 give 8 kHz only",
+    );
+    assert_error(
+        &chip("model = \"mpu6500\"\n[chip.filters]\ndlpf_cfg = 300\n"),
+        "7:12",
+        "300 is not a register code (0-255)",
+    );
+    assert_error(
+        &chip("model = \"ist8310\"\n[chip.filters]\ndlpf_cfg = 1\n"),
+        "6:1",
+        "the IST8310 is a magnetometer: it has no filters",
+    );
+    let dev =
+        format!("{BASE}\n[[device]]\nmodel = \"icm42688p\"\n[device.filters]\ngyro_ui_bw = 9\n");
+    assert_error(
+        &dev,
+        "7:1",
+        "gyro_ui_bw = 9 is out of range (allowed: 0-7, 14, 15)",
+    );
+}
+
+#[test]
+fn filters_left_out_take_the_defaults() {
+    use margemu_protocol::chip::ChainConfig;
+    let text = format!("{BASE}[chip]\nmodel = \"mpu9250\"\n[chip.filters]\ndlpf_cfg = 3\n");
+    let scene = Scene::parse_str(&text, Path::new("f.toml")).unwrap();
+    assert_eq!(
+        scene.chip.chain,
+        Some(ChainConfig::Mpu6xxx {
+            dlpf_cfg: 3,
+            fchoice_b: 0,
+            a_dlpf_cfg: 0,
+            accel_fchoice_b: false
+        })
+    );
+    let plain = Scene::parse_str(BASE, Path::new("p.toml")).unwrap();
+    assert_eq!(
+        plain.chip.chain,
+        Some(ChainConfig::Mpu6xxx {
+            dlpf_cfg: 1,
+            fchoice_b: 0,
+            a_dlpf_cfg: 0,
+            accel_fchoice_b: false
+        })
+    );
+    let text = format!("{BASE}[chip]\nmodel = \"qmc5883l\"\n");
+    assert_eq!(
+        Scene::parse_str(&text, Path::new("q.toml"))
+            .unwrap()
+            .chip
+            .chain,
+        None
+    );
+}

@@ -84,6 +84,20 @@ pub enum Error {
     PsdTooFine,
     /// A chip's sampling chain cannot be built for its configuration (a scene check missed it).
     ChainRefused,
+    /// A filter order outside 1 to [`crate::chain::filter::MAX_ORDER`].
+    FilterOrder {
+        /// The order asked for.
+        order: u8,
+    },
+    /// A filter design needs more than [`crate::chain::filter::MAX_SECTIONS`] sections.
+    TooManyFilterSections,
+    /// Two filter designs cascaded run at different rates.
+    FilterRateMismatch,
+    /// A filter's pure delay exceeds [`crate::chain::filter::MAX_DELAY`] samples.
+    FilterDelayTooLong {
+        /// The delay asked for, samples.
+        samples: usize,
+    },
 }
 
 impl fmt::Display for Error {
@@ -152,6 +166,24 @@ impl fmt::Display for Error {
                 "the PSD's lowest breakpoint is too low for the internal rate (synthesis block \
                  over {} samples)",
                 crate::vibration::random::MAX_FFT_LEN
+            ),
+            Error::FilterOrder { order } => write!(
+                f,
+                "filter order {order} is outside 1 to {}",
+                crate::chain::filter::MAX_ORDER
+            ),
+            Error::TooManyFilterSections => write!(
+                f,
+                "filter design needs more than {} sections",
+                crate::chain::filter::MAX_SECTIONS
+            ),
+            Error::FilterRateMismatch => {
+                f.write_str("cascaded filter designs run at different rates")
+            }
+            Error::FilterDelayTooLong { samples } => write!(
+                f,
+                "filter delay of {samples} samples exceeds {} samples",
+                crate::chain::filter::MAX_DELAY
             ),
         }
     }

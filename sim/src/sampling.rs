@@ -18,7 +18,7 @@ use margemu_model::chain::{DeviceChain, SensorPath};
 use margemu_model::perturbation::Complex;
 use margemu_model::vibration::{RpmPoint, Sense, Vibration};
 use margemu_model::Error;
-use margemu_protocol::chip::chain::ChipChain;
+use margemu_protocol::chip::chain::{ChipChain, SensorChain};
 
 /// A device's chain with host-owned buffers.
 pub type HostChain = DeviceChain<Vec<RpmPoint>, Vec<Complex>>;
@@ -39,10 +39,10 @@ pub fn uses_internal_path(scene: &Scene, vibration: &DeviceVibration) -> bool {
 /// The chip's declared chain at the scene's output rate (`None` for a magnetometer).
 pub fn chip_chain(scene: &Scene, chip: &ChipSetup) -> Option<Result<ChipChain, Error>> {
     let config = chip.chain.as_ref()?;
-    Some(
-        ChipChain::new(&chip.settings, config, scene.spec.rate_fraction())
-            .map_err(|_| Error::ChainRefused),
-    )
+    let Some(rate) = crate::scene::chip::link_rate(scene.clock.hz()) else {
+        return Some(Err(Error::ChainRefused));
+    };
+    Some(ChipChain::new(&chip.settings, config, rate).map_err(|_| Error::ChainRefused))
 }
 
 /// The chain of a device mounted as `chip`, with `vibration` reaching it (chip axes) and the
@@ -53,20 +53,26 @@ pub fn build(
     vibration: &DeviceVibration,
     seed: u64,
 ) -> Option<Result<HostChain, Error>> {
+    let [accel_range, gyro_range] = chip.settings.front_end_ranges()?;
+    if !uses_internal_path(scene, vibration) {
+        let period = libm_round(1e9 / scene.clock.hz());
+        let path = |sense, range| -> Result<HostPath, Error> {
+            SensorPath::at_output(range, sensor_vibration(sense, period, seed, vibration)?)
+        };
+        return Some((|| {
+            Ok(DeviceChain {
+                accel: path(Sense::Linear, accel_range)?,
+                gyro: path(Sense::Angular, gyro_range)?,
+            })
+        })());
+    }
     let declared = match chip_chain(scene, chip)? {
         Ok(c) => c,
         Err(e) => return Some(Err(e)),
     };
-    let internal = uses_internal_path(scene, vibration);
-    let output_period = libm_round(1e9 / scene.clock.hz());
-    let path = |sense: Sense, spec: &margemu_protocol::chip::chain::SensorChain| {
-        if internal {
-            let vib = sensor_vibration(sense, spec.period_ns, seed, vibration)?;
-            SensorPath::new(spec.period_ns, spec.filter, spec.range, vib)
-        } else {
-            let vib = sensor_vibration(sense, output_period, seed, vibration)?;
-            SensorPath::at_output(spec.range, vib)
-        }
+    let path = |sense, spec: &SensorChain| -> Result<HostPath, Error> {
+        let vib = sensor_vibration(sense, spec.period_ns, seed, vibration)?;
+        SensorPath::new(spec.period_ns, spec.filter, spec.range, vib)
     };
     Some((|| {
         Ok(DeviceChain {

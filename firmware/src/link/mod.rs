@@ -442,7 +442,7 @@ impl<const N: usize> Core<N> {
         };
         let model = match &c.source {
             Source::Images => None,
-            Source::Model(p) => match Model::new(p, c.rate) {
+            Source::Model(p) => match Model::new(p, c.rate, &chip) {
                 Some(m) => Some(m),
                 None => return self.refuse(ErrorCode::InvalidConfig, seq, 0),
             },
@@ -614,7 +614,7 @@ impl<const N: usize> Core<N> {
                     }
                     _ => false,
                 };
-                (model.image(self.rig.primary()), !fresh)
+                (model.image(t, self.rig.primary()), !fresh)
             }
         };
         if let Some(image) = &image {

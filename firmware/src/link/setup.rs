@@ -1,7 +1,10 @@
 //! Applying a [`Configure`]: the chip (model, identity, image length, I2C address), its register
 //! overrides, and the model of source mode (b).
 
+use margemu_model::chain::{DeviceChain, SensorPath};
+use margemu_model::perturbation::Complex;
 use margemu_model::sensor::{Marg, Truth};
+use margemu_model::vibration::{RpmPoint, Sense, Vibration};
 use margemu_protocol::chip::PhysicalSample;
 use margemu_protocol::link::{Chips, Configure, ErrorCode, Image, ModelParams, Rate, Source};
 
@@ -32,10 +35,59 @@ pub fn build_chip(cfg: &Configure) -> Result<EmulatedChip, ErrorCode> {
     Ok(chip)
 }
 
-/// Source mode (b): the shared sensor model at the output rate, fed by the latest kinematics.
-#[derive(Clone, Debug)]
-pub struct Model {
+/// The sensor model of source mode (b) at the output rate: the front end on the output path
+/// (clipping at the chip's full scale, counted; no vibration) and the error terms. The host's
+/// model of a device without vibration is the same ([`DeviceModel::new`] on both sides).
+pub struct DeviceModel {
     marg: Marg,
+    front: Option<DeviceChain<[RpmPoint; 0], [Complex; 0]>>,
+}
+
+impl DeviceModel {
+    /// The model of `cfg` at `rate_hz` with `seed`, clipping at `chip`'s full scale (none for a
+    /// magnetometer-only chip).
+    pub fn new(
+        cfg: &margemu_model::sensor::MargConfig,
+        rate_hz: f64,
+        seed: u64,
+        chip: &impl Chip,
+    ) -> Result<Self, margemu_model::Error> {
+        let marg = Marg::new(cfg, rate_hz, seed)?;
+        let front = match chip.settings().front_end_ranges() {
+            None => None,
+            Some([accel, gyro]) => {
+                let path = |sense, range| {
+                    SensorPath::at_output(range, Vibration::new(sense, 1, seed))
+                };
+                Some(DeviceChain {
+                    accel: path(Sense::Linear, accel)?,
+                    gyro: path(Sense::Angular, gyro)?,
+                })
+            }
+        };
+        Ok(Self { marg, front })
+    }
+
+    /// One output sample at `t_ns` from `truth`.
+    #[inline]
+    pub fn sample(&mut self, t_ns: u64, truth: &Truth) -> margemu_model::sensor::Sample {
+        match self.front.as_mut() {
+            Some(front) => front.sample(&mut self.marg, t_ns, truth),
+            None => self.marg.sample(truth),
+        }
+    }
+
+    /// Front-end clipping so far, `[accel, gyro]` per axis (zeros without a front end).
+    pub fn clips(&self) -> [[u64; 3]; 2] {
+        self.front
+            .as_ref()
+            .map_or([[0; 3]; 2], |f| [f.accel.clips(), f.gyro.clips()])
+    }
+}
+
+/// Source mode (b): the shared sensor model at the output rate, fed by the latest kinematics.
+pub struct Model {
+    model: DeviceModel,
     truth_rate: Rate,
     mag_ut_per_unit: f64,
     held: Option<Truth>,
@@ -44,10 +96,10 @@ pub struct Model {
 impl Model {
     /// The model of `params` at the output `rate`; `None` if the model refuses the terms.
     /// A perturbation is refused by the caller (it needs buffers this device does not have).
-    pub fn new(params: &ModelParams, rate: Rate) -> Option<Self> {
-        let marg = Marg::new(&params.marg, rate.as_hz_f64(), params.seed).ok()?;
+    pub fn new(params: &ModelParams, rate: Rate, chip: &impl Chip) -> Option<Self> {
+        let model = DeviceModel::new(&params.marg, rate.as_hz_f64(), params.seed, chip).ok()?;
         Some(Self {
-            marg,
+            model,
             truth_rate: params.truth_rate,
             mag_ut_per_unit: params.mag_ut_per_unit,
             held: None,
@@ -72,10 +124,11 @@ impl Model {
 
     /// One output sample from the held kinematics, as the register image the chip serves
     /// (`None` before the first kinematics sample: the model does not step).
-    pub fn image(&mut self, chip: &impl Chip) -> Option<Image> {
+    pub fn image(&mut self, t_ns: u64, chip: &impl Chip) -> Option<Image> {
         let truth = self.held?;
         Some(model_image(
-            &mut self.marg,
+            &mut self.model,
+            t_ns,
             &truth,
             self.mag_ut_per_unit,
             chip,
@@ -95,17 +148,18 @@ pub fn truth_index_at(rate: Rate, t_ns: u64) -> u64 {
 /// Die temperature assumed when the kinematics carry none, °C (the MPU-9250's TEMP_OUT 0).
 pub const DEFAULT_TEMP_C: f32 = 21.0;
 
-/// The image of one model step, exactly as the device computes it in source mode (b), so a
-/// host can predict it: the model's sample, the field scaled to µT as
+/// The image of one model step at `t_ns`, exactly as the device computes it in source mode (b),
+/// so a host can predict it: the model's sample, the field scaled to µT as
 /// `(f64::from(mag) * mag_ut_per_unit) as f32`, the temperature of the kinematics
 /// ([`DEFAULT_TEMP_C`] when absent), converted with the chip's current [`Chip::settings`].
 pub fn model_image(
-    marg: &mut Marg,
+    model: &mut DeviceModel,
+    t_ns: u64,
     truth: &Truth,
     mag_ut_per_unit: f64,
     chip: &impl Chip,
 ) -> Image {
-    let s = marg.sample(truth);
+    let s = model.sample(t_ns, truth);
     let sample = PhysicalSample {
         acc: s.acc,
         gyr: s.gyr,

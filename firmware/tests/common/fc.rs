@@ -19,6 +19,8 @@
 //!   afterwards) from FIFO_R_W; each record's temperature is checked against a cached TEMP_OUT:
 //!   within 400 LSB passes, else TEMP_OUT (0x41) is read again and the record passes within
 //!   800 LSB; a failing record resets the FIFO and drops the rest of the read.
+//! - [`px4_mpu9250`]: the same sequence as the MPU-9250 driver (WHO_AM_I 0x71, I2C_IF_DIS in
+//!   USER_CTRL).
 //! - [`px4_icm20602`]: PX4 `icm20602/ICM20602.cpp`: DEVICE_RESET, PWR_MGMT_1 = CLKSEL 1,
 //!   I2C_IF = I2C_IF_DIS, ACCEL_CONFIG2 = ACCEL_FCHOICE_B (4 kHz), CONFIG = FIFO_MODE |
 //!   DLPF_CFG 7 (8 kHz), GYRO_CONFIG = ±2000 °/s, ACCEL_CONFIG = ±16 g, FIFO_EN = GYRO | ACCEL,
@@ -280,27 +282,56 @@ fn ardupilot_fifo_reset<B: Board>(board: &mut B, user_ctrl: u8) -> u8 {
 /// PX4's ICM-20602 driver at 8 kHz: configure, then `polls` FIFO bursts 1 ms apart, each
 /// checked for the duplicated-accel pattern. Returns the records of every transfer it accepted.
 pub fn px4_icm20602<B: Board>(board: &mut B, polls: usize) -> Result<FcRun, FcError> {
+    px4_fifo_8khz(board, polls, 0x12, (0x70, 0x40), 0x18)
+}
+
+/// PX4's MPU-9250 driver (`src/drivers/imu/invensense/mpu9250/MPU9250.cpp`) at 8 kHz: the
+/// ICM-20602's sequence with WHO_AM_I 0x71, I2C_IF_DIS in USER_CTRL (bit 4) and FIFO_EN
+/// naming temperature, each gyro axis and the accelerometer (the same 14-byte records).
+pub fn px4_mpu9250<B: Board>(board: &mut B, polls: usize) -> Result<FcRun, FcError> {
+    px4_fifo_8khz(board, polls, 0x71, (0x6A, 0x10), 0xF8)
+}
+
+/// The PX4 InvenSense 8 kHz FIFO sequence for a part answering `who_am_i`, with its I2C
+/// interface disabled by `(register, value)` and `fifo_en` giving 14-byte records.
+fn px4_fifo_8khz<B: Board>(
+    board: &mut B,
+    polls: usize,
+    who_am_i: u8,
+    i2c_if_dis: (u8, u8),
+    fifo_en: u8,
+) -> Result<FcRun, FcError> {
     write(board, 0x6B, 0x80);
     board.wait_ns(2_000_000);
-    let who_am_i = read(board, 0x75, 1)[0];
-    if who_am_i != 0x12 {
-        return Err(FcError::WhoAmI(who_am_i));
+    let got = read(board, 0x75, 1)[0];
+    if got != who_am_i {
+        return Err(FcError::WhoAmI(got));
     }
+    let user_ctrl = if i2c_if_dis.0 == 0x6A {
+        i2c_if_dis.1
+    } else {
+        0
+    };
     for (reg, value) in [
         (0x6B, 0x01), // CLKSEL 1
-        (0x70, 0x40), // I2C_IF_DIS
-        (0x1D, 0x08), // ACCEL_FCHOICE_B: 4 kHz
-        (0x1A, 0x47), // FIFO_MODE, DLPF_CFG 7: 8 kHz
-        (0x1B, 0x18), // ±2000 °/s
-        (0x1C, 0x18), // ±16 g
-        (0x23, 0x18), // GYRO_FIFO_EN | ACCEL_FIFO_EN
-        (0x37, 0xA0), // active low, latched
+        i2c_if_dis,
+        (0x1D, 0x08),    // ACCEL_FCHOICE_B: 4 kHz
+        (0x1A, 0x47),    // FIFO_MODE, DLPF_CFG 7: 8 kHz
+        (0x1B, 0x18),    // ±2000 °/s
+        (0x1C, 0x18),    // ±16 g
+        (0x23, fifo_en), // gyro and accel (and, on the MPU-9250, temperature)
+        (0x37, 0xA0),    // active low, latched
         (0x38, 0x01),
-        (0x6A, 0x44), // FIFO_EN | FIFO_RST
+        (0x6A, user_ctrl | 0x44), // FIFO_EN | FIFO_RST
     ] {
         write(board, reg, value);
     }
-    for (reg, value) in [(0x1A, 0x47), (0x1D, 0x08), (0x23, 0x18), (0x70, 0x40)] {
+    let check = if user_ctrl == 0 {
+        i2c_if_dis
+    } else {
+        (0x1A, 0x47)
+    };
+    for (reg, value) in [(0x1A, 0x47), (0x1D, 0x08), (0x23, fifo_en), check] {
         let back = read(board, reg, 1)[0];
         if back != value {
             return Err(FcError::ReadBack(reg, back));

@@ -76,6 +76,58 @@ pub fn numbered(k: u64) -> PhysicalSample {
     }
 }
 
+/// Configures `c` (CONFIG, GYRO_CONFIG ±2000 °/s with `fchoice_b`, ACCEL_CONFIG ±16 g,
+/// ACCEL_CONFIG2), latches `n` numbered samples at its output clock and returns the ACCEL_XOUT
+/// read after each (checking that the gyro takes every sample).
+pub fn accel_after_each(
+    mut c: Mpu6xxx,
+    config: u8,
+    fchoice_b: u8,
+    config2: u8,
+    n: u64,
+) -> Vec<i16> {
+    spi_write(&mut c, 0x6B, &[0x01]);
+    spi_write(&mut c, 0x1A, &[config]);
+    spi_write(&mut c, 0x1B, &[0x18 | fchoice_b]);
+    spi_write(&mut c, 0x1C, &[0x18]);
+    spi_write(&mut c, 0x1D, &[config2]);
+    let period = c.sample_period_ns();
+    (1..=n)
+        .map(|k| {
+            c.latch_at(&numbered(k), k * period);
+            let d = spi_read(&mut c, 0x3B, 14);
+            assert_eq!(be(&d, 8), k as i16, "the gyro takes every sample");
+            be(&d, 0)
+        })
+        .collect()
+}
+
+/// Sample numbers `1..=n` at `period` ns with each accel value taken at the first sample of
+/// its `accel` ns period (sample 1 being the first).
+pub fn expected_accel(period: u64, accel: u64, n: u64) -> Vec<i16> {
+    let mut from = 1;
+    (1..=n)
+        .map(|k| {
+            if k > 1 && (k * period) / accel != ((k - 1) * period) / accel {
+                from = k;
+            }
+            from as i16
+        })
+        .collect()
+}
+
+/// The runs of equal ACCEL_XOUT in `records`, as (value, count).
+pub fn accel_runs(records: &[fc::Record]) -> Vec<(i16, usize)> {
+    let mut runs: Vec<(i16, usize)> = Vec::new();
+    for r in records {
+        match runs.last_mut() {
+            Some((a, n)) if *a == r.accel_x => *n += 1,
+            _ => runs.push((r.accel_x, 1)),
+        }
+    }
+    runs
+}
+
 /// What a [`Bench`] needs of the chip on it: an [`Mpu6xxx`], or the same chip behind another
 /// bus path (the SPI shadow's measuring rig).
 pub trait BenchChip: SpiTarget {

@@ -28,13 +28,7 @@ fn px4_reads_the_8_khz_fifo_with_duplicated_accel() {
         "none left behind"
     );
     // Each accel value exactly twice in a row.
-    let mut runs: Vec<(i16, usize)> = Vec::new();
-    for r in &run.records {
-        match runs.last_mut() {
-            Some((a, n)) if *a == r.accel_x => *n += 1,
-            _ => runs.push((r.accel_x, 1)),
-        }
-    }
+    let runs = accel_runs(&run.records);
     let inner = &runs[1..runs.len() - 1];
     assert!(inner.iter().all(|&(_, n)| n == 2), "{runs:?}");
 }

@@ -5,38 +5,8 @@
 
 use super::*;
 
-/// Configures CONFIG, GYRO_CONFIG (±2000 °/s), ACCEL_CONFIG (±16 g), ACCEL_CONFIG2; latches `n`
-/// numbered samples at the chip's output clock; returns the ACCEL_XOUT read after each.
 fn accel_after_each(variant: Variant, config: u8, fchoice_b: u8, config2: u8, n: u64) -> Vec<i16> {
-    let mut c = chip(variant);
-    spi_write(&mut c, 0x6B, &[0x01]);
-    spi_write(&mut c, 0x1A, &[config]);
-    spi_write(&mut c, 0x1B, &[0x18 | fchoice_b]);
-    spi_write(&mut c, 0x1C, &[0x18]);
-    spi_write(&mut c, 0x1D, &[config2]);
-    let period = c.sample_period_ns();
-    (1..=n)
-        .map(|k| {
-            c.latch_at(&numbered(k), k * period);
-            let d = spi_read(&mut c, 0x3B, 14);
-            assert_eq!(be(&d, 8), k as i16, "the gyro takes every sample");
-            be(&d, 0)
-        })
-        .collect()
-}
-
-/// Sample numbers `1..=n` at `period` ns with each accel value taken at the first sample of
-/// its `accel` ns period (sample 1 being the first).
-fn expected(period: u64, accel: u64, n: u64) -> Vec<i16> {
-    let mut from = 1;
-    (1..=n)
-        .map(|k| {
-            if k > 1 && (k * period) / accel != ((k - 1) * period) / accel {
-                from = k;
-            }
-            from as i16
-        })
-        .collect()
+    common::accel_after_each(chip(variant), config, fchoice_b, config2, n)
 }
 
 #[test]
@@ -57,7 +27,7 @@ fn every_setting() {
             let got = accel_after_each(variant, config, fchoice_b, config2, 40);
             assert_eq!(
                 got,
-                expected(period, accel, 40),
+                expected_accel(period, accel, 40),
                 "{variant:?} CONFIG {config:#04x} FCHOICE_B {fchoice_b} ACCEL_CONFIG2 {config2:#04x}"
             );
         }

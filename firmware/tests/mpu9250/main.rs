@@ -6,6 +6,7 @@
 
 #![allow(missing_docs)]
 
+mod accel_rate;
 mod aux_master;
 mod bus_i2c;
 mod bus_spi;
@@ -17,12 +18,13 @@ mod random_sequences;
 mod resets;
 mod write_log;
 
+/// The 6xxx helpers (bench, flight-controller sequences, accel-rate helpers), by path.
+#[path = "../common/mod.rs"]
+mod common;
 #[path = "../common/random_ops.rs"]
 mod random_ops;
-#[path = "../common/transactions.rs"]
-mod transactions;
-
-pub use transactions::*;
+use common::transactions;
+pub use common::transactions::*;
 
 use margemu_firmware::chip::{Config, I2cTarget, Mpu6xxx, PhysicalSample, SpiTarget};
 

@@ -28,6 +28,7 @@
 //! assert_eq!(&samples[0].image[4..6], &[0x40, 0x00]);
 //! ```
 
+use super::clipping::Clips;
 use super::predictor::{run_scene, Halt, Predictions};
 use margemu_protocol::chip::{ChipSettings, PhysicalSample};
 use margemu_protocol::link::Image;
@@ -75,6 +76,8 @@ pub struct PredictedSample {
     pub truth: Truth,
     /// The register image, of the chip model's length.
     pub image: Image,
+    /// Each device's front-end clipping so far ([`super::clipping`]).
+    pub clips: Clips,
 }
 
 /// Every sample of `scene`, in order, predicted lazily on a thread of its own (see
@@ -102,7 +105,8 @@ pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<Pr
             });
             let mut image = [0u8; margemu_protocol::chip::MAX_IMAGE_LEN];
             let mut len = 0;
-            for (marg, chip, chip_settings) in &mut devices {
+            let mut clips = Clips::default();
+            for ((marg, chip, chip_settings), clip) in devices.iter_mut().zip(&mut clips) {
                 let s = marg
                     .try_sample(&scene, &in_chip_axes(truth, chip))
                     .map_err(|e| Halt::Failed(margemu_sim::run::RunError::NonFinite(e)))?
@@ -115,6 +119,7 @@ pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<Pr
                         .map(|v| (f64::from(v) * settings.mag_ut_per_unit) as f32),
                     temp_c,
                 };
+                *clip = marg.clips();
                 let one = chip_settings.image(&sample);
                 let end = (len + one.len()).min(image.len());
                 image[len..end].copy_from_slice(&one[..end - len]);
@@ -123,6 +128,7 @@ pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<Pr
             Ok(emit(PredictedSample {
                 truth: *truth,
                 image: Image::new(&image[..len]).unwrap_or_default(),
+                clips,
             })?)
         })
     })

@@ -11,6 +11,7 @@
 //! |---|---|
 //! | `truth.csv` | as `simulate` writes it (`docs/ground-truth.md`), one row per sample, written as the session predicts them (in order, a window ahead of what it sends): every sample of the scene once the session completes |
 //! | `device_truth.csv` | a rig's only: `t_ns,device,wx,wy,wz,fx,fy,fz,dwx,dwy,dwz,mx,my,mz`, each sample's truth per device in the device's own axes, the specific force at its mounting point ([`super::device_truth`]) |
+//! | `clipping.csv` | `t_ns,device,accel_x,accel_y,accel_z,gyro_x,gyro_y,gyro_z`: each device's front-end clipping counters, cumulative, a row when they change and the totals at the end ([`super::clipping`]) |
 //! | `sent.csv` | one row per item written, in the order written. Source images: `index,t_ns,send_ns,late_ns,image,resend`: sample index, its latch instant, when the write of its batch to the port completed, how late that was against the batch's schedule `start_host_ns + t_ns − lead` of its first sample (empty for the prefill, written before Start, and for resends), the register image as two lowercase hex digits per byte (`Image`'s `{:x}`, read back by `Image::parse_hex`; 44 digits for the 22-byte MPU-9250 image), and `1` if the item was written again because the device had not received it (go-back-N; `0` for the first copy). Source model: `index,t_ns,send_ns,late_ns,wx,wy,wz,fx,fy,fz,mx,my,mz,dwx,dwy,dwz,temp_c,resend`: the kinematics sample's index and instant at the kinematics rate, the same times, the `f32` values sent (body rate rad/s, specific force m/s², field in the scene's unit, angular acceleration rad/s², die temperature °C or empty), shortest round-trip, and the resend flag |
 //! | `served.csv` | `host_ns,index,time_ns,crc32c,underrun,empty,match`: every sample instant the device reports it served (its Served messages), in the order received: the output sample index, the device scene time it was served at (the message's time for its first entry; the spec's `rate.sample_time_ns(index)` for the others), the CRC-32C of the 22-byte image latched into the chip (8 lowercase hex digits), `1` if the sample was missing (underrun: the previous image was held) or no image existed yet (empty), and `1` if the CRC equals that of the host's predicted image of that index, `0` if not, empty for instants after the scene's last sample and for entries the check cannot verify (see `served.rs`) |
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
@@ -22,6 +23,7 @@
 //! ended; [`margemu_sim::rundir`]), written once every file is closed: after the session, or after
 //! the device under test's reader when one is attached.
 
+use super::clipping::{ClippingWriter, Clips};
 use super::device_truth::DeviceTruthWriter;
 use margemu_model::sensor;
 use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
@@ -47,9 +49,10 @@ pub const REGISTER_WRITES_FILE: &str = "register_writes.csv";
 pub const EVENTS_FILE: &str = "events.csv";
 
 /// The files of a session besides `meta.toml`.
-pub const SESSION_FILES: [&str; 8] = [
+pub const SESSION_FILES: [&str; 9] = [
     TRUTH_FILE,
     super::device_truth::DEVICE_TRUTH_FILE,
+    super::clipping::CLIPPING_FILE,
     SENT_FILE,
     SERVED_FILE,
     DEVICE_FILE,
@@ -142,6 +145,8 @@ pub struct SessionLog {
     devices: Vec<WrittenDevice>,
     /// A rig's `device_truth.csv`.
     device_truth: Option<DeviceTruthWriter>,
+    /// `clipping.csv`.
+    clipping: ClippingWriter,
 }
 
 fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
@@ -184,6 +189,10 @@ impl SessionLog {
             image_split,
             devices: written_devices(devices),
             device_truth: DeviceTruthWriter::create(dir, devices)?,
+            clipping: ClippingWriter::create(
+                dir,
+                &devices.iter().map(|d| d.name.clone()).collect::<Vec<_>>(),
+            )?,
         };
         log.flush()?;
         Ok(log)
@@ -206,6 +215,13 @@ impl SessionLog {
             Some(d) => d.write(truths),
             None => Ok(()),
         }
+    }
+
+    /// Each output sample's clipping counters (`t_ns`, every device's), in order.
+    pub fn clipping(&mut self, clips: &[(u64, Clips)]) -> io::Result<()> {
+        clips
+            .iter()
+            .try_for_each(|(t_ns, c)| self.clipping.write(*t_ns, c))
     }
 
     /// One row of `sent.csv` in source mode images.
@@ -365,8 +381,15 @@ impl SessionLog {
         )
     }
 
+    /// Writes what closes a file (the clipping totals) and flushes every file.
+    pub fn close(&mut self) -> io::Result<()> {
+        self.clipping.finish()?;
+        self.flush()
+    }
+
     /// Flushes every file to the operating system.
     pub fn flush(&mut self) -> io::Result<()> {
+        self.clipping.flush()?;
         self.sent.flush()?;
         self.served.flush()?;
         self.device.flush()?;

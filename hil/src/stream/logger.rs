@@ -45,7 +45,7 @@ impl Logger {
                     }
                     log.flush()?;
                 }
-                log.flush()
+                log.close()
             })?;
         Ok(Self {
             dir,

@@ -77,6 +77,7 @@
 //! `events.csv`.
 
 pub mod clock;
+pub mod clipping;
 pub mod device_truth;
 mod ending;
 mod flow;

@@ -41,13 +41,14 @@
 //! assert_eq!(p.params.truth_rate.as_hz_f64(), 250.0);
 //! ```
 
+use super::clipping::Clips;
 use super::images::{in_chip_axes, ImageSettings, PredictedSample};
 use super::predictor::{run_scene, Predictions};
 use super::session::rate_of;
 use super::StreamError;
 use margemu_firmware::chip::{Chip, EmulatedChip};
-use margemu_firmware::link::setup;
-use margemu_model::sensor::{self, Marg};
+use margemu_firmware::link::setup::{self, DeviceModel};
+use margemu_model::sensor;
 use margemu_protocol::link::{Image, ModelParams, Rate};
 use margemu_sim::scene::chip::ChipSetup;
 use margemu_sim::scene::Scene;
@@ -100,6 +101,9 @@ pub fn predict_model(
                 .into(),
         });
     }
+    if let Some(reason) = vibration_refusal(scene) {
+        return Err(StreamError::Model { reason });
+    }
     let rate = rate_of(scene)?;
     let chip = device_chip(&scene.chip, rate)?;
     if settings.chip != chip.settings() {
@@ -117,7 +121,7 @@ pub fn predict_model(
     };
     let scene = scene.clone();
     let samples = Predictions::spawn(move |emit| {
-        let mut marg = Marg::new(&params.marg, rate.as_hz_f64(), params.seed)
+        let mut model = DeviceModel::new(&params.marg, rate.as_hz_f64(), params.seed, &chip)
             .map_err(margemu_sim::run::RunError::Model)?;
         let temperature = scene.spec.sensors.temperature;
         let (mut k, mut held) = (0u64, None);
@@ -126,12 +130,18 @@ pub fn predict_model(
                 .then(|| kinematics_of(&in_chip_axes(truth, &scene.chip), temperature));
             held = kinematics.or(held);
             let t = held.as_ref().expect("sample 0 brings kinematics");
-            let image = setup::model_image(&mut marg, t, params.mag_ut_per_unit, &chip);
+            let image =
+                setup::model_image(&mut model, truth.t_ns, t, params.mag_ut_per_unit, &chip);
             k += 1;
+            let [accel, gyro] = model.clips();
+            let mut clips = Clips::default();
+            clips[0] = Some(margemu_sim::marg::ClipCounts { accel, gyro })
+                .filter(|_| chip.settings().front_end_ranges().is_some());
             Ok(emit(ModelSample {
                 sample: PredictedSample {
                     truth: *truth,
                     image,
+                    clips,
                 },
                 kinematics,
             })?)
@@ -141,6 +151,29 @@ pub fn predict_model(
         hold,
         params,
         samples,
+    })
+}
+
+/// Why source mode (b) cannot run `scene`'s sampling chain, if it cannot: vibration, or the
+/// chip's internal-rate path asked for. The device's model runs at the output rate from held
+/// kinematics; the vibration sources and the internal-rate filters are not carried by the link.
+pub fn vibration_refusal(scene: &Scene) -> Option<String> {
+    let vibrates = scene.vibration.iter().any(|v| !v.is_empty());
+    let internal = scene.sampling == margemu_sim::scene::vibration::SamplingPath::Internal;
+    (vibrates || internal).then(|| {
+        format!(
+            "the scene has {}: source mode (b) runs the sensor model on the device at the \
+             output rate from held kinematics, without vibration or the chip's internal-rate \
+             filters (the chain costs the Cortex-M4F {}; see the guide's sampling-chain \
+             figures); stream it as register images (source images), where the host runs the \
+             chain",
+            if vibrates {
+                "[vibration]"
+            } else {
+                "[vibration] path = \"internal\""
+            },
+            "thousands of instructions per output sample at 8 kHz"
+        )
     })
 }
 
@@ -164,11 +197,14 @@ pub fn model_images(
     samples: usize,
     chip: &impl Chip,
 ) -> Result<Vec<Image>, StreamError> {
-    let mut marg = Marg::new(&params.marg, rate.as_hz_f64(), params.seed)
+    let mut model = DeviceModel::new(&params.marg, rate.as_hz_f64(), params.seed, chip)
         .map_err(margemu_sim::run::RunError::Model)?;
-    let held = (0..samples).filter_map(|k| kinematics.get(k / hold.max(1) as usize));
+    let held = (0..samples).filter_map(|k| {
+        let t = kinematics.get(k / hold.max(1) as usize)?;
+        Some((rate.sample_time_ns(k as u64), t))
+    });
     Ok(held
-        .map(|t| setup::model_image(&mut marg, t, params.mag_ut_per_unit, chip))
+        .map(|(t_ns, t)| setup::model_image(&mut model, t_ns, t, params.mag_ut_per_unit, chip))
         .collect())
 }
 

@@ -202,6 +202,7 @@ impl Source {
         let target = end.saturating_mul(self.hold()).min(self.samples);
         let p = &mut self.prediction;
         let mut truths = Vec::new();
+        let mut clips = Vec::new();
         while p.outputs < target {
             let Some(next) = p.stream.next() else {
                 return Err(StreamError::PredictionEnded {
@@ -212,6 +213,7 @@ impl Source {
             let (sample, item) = next?;
             served.expect(p.outputs, CRC32C.checksum(&sample.image));
             truths.push(sample.truth);
+            clips.push((sample.truth.t_ns, sample.clips));
             if let Some(item) = item {
                 p.items.push(item);
             }
@@ -220,7 +222,10 @@ impl Source {
         if truths.is_empty() {
             return Ok(());
         }
-        log.queue(move |log| log.truth(&truths))
+        log.queue(move |log| {
+            log.truth(&truths)?;
+            log.clipping(&clips)
+        })
     }
 
     /// The kept items `first .. first + n` (a go-back never reaches further back than the

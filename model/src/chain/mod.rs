@@ -74,7 +74,7 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> SensorPath<P,
         if period_ns == 0 {
             return Err(Error::InvalidRate);
         }
-        if !(range > 0.0) {
+        if range.is_nan() || range <= 0.0 {
             return Err(Error::NonPositiveParameter { what: "chain.range" });
         }
         Ok(Self {

@@ -94,7 +94,7 @@ impl RandomSource {
     pub fn fft_len(&self, rate_hz: f64) -> Result<usize, Error> {
         let lowest = self.points().first().map_or(1.0, |p| p.f_hz);
         let wanted = libm::ceil(16.0 * rate_hz / lowest).max(64.0);
-        if !(wanted <= MAX_FFT_LEN as f64) {
+        if wanted.is_nan() || wanted > MAX_FFT_LEN as f64 {
             return Err(Error::PsdTooFine);
         }
         let n = next_smooth(wanted as usize).ok_or(Error::PsdTooFine)?;
@@ -139,7 +139,10 @@ impl<B: AsMut<[Complex]> + AsRef<[Complex]>> Random<B> {
         let scratch_len = plan.scratch_len();
         let buf = buffers.as_mut();
         if buf.len() < scratch_len + 5 * n {
-            return Err(Error::BufferTooSmall { needed: scratch_len + 5 * n, got: buf.len() });
+            return Err(Error::BufferTooSmall {
+                needed: scratch_len + 5 * n,
+                got: buf.len(),
+            });
         }
         let (scratch, rest) = buf.split_at_mut(scratch_len);
         plan.init(scratch)?;
@@ -184,7 +187,12 @@ impl<B: AsMut<[Complex]> + AsRef<[Complex]>> Random<B> {
         let (hw, blocks) = rest.split_at_mut(n);
         for b in 0..2 {
             let start = (2 * pair + b) * n;
-            let block = blocks.get_mut(start..start + n).ok_or(Error::BufferTooSmall { needed: start + n, got: 0 })?;
+            let block = blocks
+                .get_mut(start..start + n)
+                .ok_or(Error::BufferTooSmall {
+                    needed: start + n,
+                    got: 0,
+                })?;
             for (z, h) in block.iter_mut().zip(hw.iter()) {
                 *z = if h.re == 0.0 {
                     Complex::ZERO

@@ -66,8 +66,8 @@ impl<P: AsRef<[RpmPoint]>> ToneSource<P> {
     }
 
     /// Changes every harmonic with `f` (e.g. to turn its amplitudes into other axes).
-    pub fn map_harmonics(&mut self, mut f: impl FnMut(&mut Harmonic)) {
-        self.harmonics.iter_mut().take(self.harmonic_count).for_each(|h| f(h));
+    pub fn map_harmonics(&mut self, f: impl FnMut(&mut Harmonic)) {
+        self.harmonics.iter_mut().take(self.harmonic_count).for_each(f);
     }
 
     /// Whether some harmonic has an amplitude in `sense`.
@@ -88,7 +88,12 @@ impl<P: AsRef<[RpmPoint]>> ToneSource<P> {
 
     /// The highest tone frequency the source reaches, Hz (max rpm · (1 + spread) / 60 · order).
     pub fn max_frequency_hz(&self) -> f64 {
-        let rpm = self.profile.as_ref().iter().map(|p| p.rpm).fold(0.0, f64::max);
+        let rpm = self
+            .profile
+            .as_ref()
+            .iter()
+            .map(|p| p.rpm)
+            .fold(0.0, f64::max);
         let order = self.harmonics().iter().map(|h| h.order).fold(0.0, f64::max);
         rpm * (1.0 + self.spread) / 60.0 * order
     }
@@ -199,9 +204,19 @@ impl<P: AsRef<[RpmPoint]>> Tones<P> {
         let _ = self.period_ns;
         let mut v = [0.0f32; 3];
         let n = self.harmonics;
-        for (scale, phases) in self.motor_scale.iter().zip(&mut self.phase).take(self.motors) {
+        for (scale, phases) in self
+            .motor_scale
+            .iter()
+            .zip(&mut self.phase)
+            .take(self.motors)
+        {
             let cycles = rpm * *scale;
-            for ((p, order), amp) in phases.iter_mut().zip(&self.orders).zip(&self.amplitudes).take(n) {
+            for ((p, order), amp) in phases
+                .iter_mut()
+                .zip(&self.orders)
+                .zip(&self.amplitudes)
+                .take(n)
+            {
                 let s = libm::sinf(core::f32::consts::TAU * *p);
                 v = [v[0] + amp[0] * s, v[1] + amp[1] * s, v[2] + amp[2] * s];
                 let q = *p + cycles * *order;

@@ -27,10 +27,12 @@
 //! assert!((reading.acc[2] - 9.80665).abs() < 1e-3);
 //! ```
 
+pub mod chain;
 mod image;
 mod model;
 mod settings;
 
+pub use chain::{ChainConfig, ChainError, ChipChain, SensorChain};
 pub use image::{Image, MAX_CHIP_IMAGE_LEN, MAX_IMAGE_LEN};
 pub use model::{ChipModel, Family};
 pub use settings::{ChipSettings, Conversion, FullScale, MagRangeError, Reading, SettingsError};

@@ -311,11 +311,11 @@ impl ChipModel {
     pub const fn not_emulated(self) -> &'static [&'static str] {
         match self.family() {
             Family::Mpu6xxx => &[
-                "the digital low-pass filters' effect on the data (settings are stored)",
+                "filter registers a driver writes at run time (the data follows the scene's [chip.filters], with [vibration] in source images only)",
                 "self-test responses, wake-on-motion, the DMP, FSYNC",
             ],
             Family::Icm42688p => &[
-                "the anti-alias and UI filters' effect on the data (settings are stored)",
+                "filter registers a driver writes at run time (the data follows the scene's [chip.filters], with [vibration] in source images only)",
                 "APEX motion features, self-test, external clock (CLKIN), FSYNC",
             ],
             Family::Ist8310 => {
@@ -324,13 +324,14 @@ impl ChipModel {
             Family::Qmc5883l => &["temperature output, over-sampling noise, the DRDY pin"],
             Family::Rm3100 => &["the DRDY pin, noise, the output's bend beyond +-800 uT"],
             Family::Bmi088 => &[
-                "the filters' effect on the data (ACC_CONF bwp and GYRO_BANDWIDTH are stored)",
+                "filter registers a driver writes at run time (the data follows the scene's [chip.filters], with [vibration] in source images only)",
                 "boot, reset and power-mode settling times, write spacing in suspend",
                 "self-test responses, FIFO tags and input pins, external FIFO sync",
                 "a board's second chip select (the Black Pill serves device 0's accel die)",
             ],
             Family::Bmi270 => &[
-                "the filters' effect on the data, pre-filtered FIFO data (settings are stored)",
+                "filter registers a driver writes at run time (the data follows the scene's [chip.filters], with [vibration] in source images only)",
+                "pre-filtered FIFO data",
                 "the configuration file's features (FEATURES pages are storage), the time init takes",
                 "FIFO sensor time, skip and configuration frames, watermark and full interrupts",
                 "low-power timing (adv_power_save is stored), the auxiliary interface, self-test, offsets",

@@ -211,6 +211,18 @@ impl ChipSettings {
         ranges.into_iter()
     }
 
+    /// The front end's ranges in SI units, `[accel m/s², gyro rad/s]`: the full scale, where a
+    /// sampling chain clips (`None` for a magnetometer).
+    pub fn front_end_ranges(&self) -> Option<[f32; 2]> {
+        self.full_scale().map(|fs| {
+            let g = f64::from(crate::regmap::mpu6xxx::convert::STANDARD_GRAVITY);
+            [
+                (fs.accel_g * g) as f32,
+                (fs.gyro_dps * core::f64::consts::PI / 180.0) as f32,
+            ]
+        })
+    }
+
     /// The accelerometer and gyroscope full scale in force; `None` for a magnetometer.
     pub fn full_scale(&self) -> Option<FullScale> {
         match &self.conversion {

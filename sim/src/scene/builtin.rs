@@ -14,7 +14,8 @@
 //! and its SHA-256, which equal the fixture file's). [`Scene::stem`] is `NAME`, which default
 //! run and session directory names use.
 //!
-//! Built-in scenes read no other files (no CSV joint sources); a unit test holds them to it.
+//! Built-in scenes read no other files (no CSV joint sources or rpm profiles); a unit test holds
+//! them to it.
 
 use super::{Scene, SceneError};
 use std::path::{Path, PathBuf};
@@ -41,7 +42,8 @@ builtins!(
     "icm42688p",
     "mpu6000",
     "rig",
-    "static"
+    "static",
+    "vibration"
 );
 
 /// The text of the built-in scene `name` (a bare name, without [`PREFIX`]).
@@ -150,6 +152,9 @@ mod tests {
                     "{name}: joint {joint} reads a CSV file"
                 );
             }
+            for (i, tone) in scene.spec.vibration.tones.iter().enumerate() {
+                assert!(tone.rpm_csv.is_none(), "{name}: tone {i} reads a CSV file");
+            }
             crate::motion::Motion::new(&scene).unwrap();
         }
     }
@@ -170,7 +175,8 @@ mod tests {
 
     #[test]
     fn unknown_arguments_list_the_built_in_names() {
-        let list = "bmi270, case-study, figure3, gimbal-lock, icm42688p, mpu6000, rig, static";
+        let list =
+            "bmi270, case-study, figure3, gimbal-lock, icm42688p, mpu6000, rig, static, vibration";
         let e = resolve(Path::new("figure4")).unwrap_err().to_string();
         assert_eq!(
             e,

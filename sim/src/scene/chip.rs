@@ -15,6 +15,10 @@
 //!                            # takes it (accel die) and the next one (gyro die)
 //! offset = [0.02, 0.0, -0.01]  # m, plate axes: the lever arm from the plate's reference point
 //! name = "imu"               # the device's name in logs (default: the model's name)
+//!
+//! [chip.filters]             # the sampling chain's filter registers, as codes (the keys of the
+//! gyro_aaf_delt = 12         # model's family; any key left out takes the value Betaflight or
+//! gyro_ui_bw = 15            # ArduPilot write at the scene's rate: `ChainConfig::default_for`)
 //! ```
 //!
 //! A scene without `[chip]` keeps the MPU-9250 at its power-on settings, mounted with the
@@ -24,9 +28,12 @@
 //! rotation (orthonormal, determinant +1).
 
 use super::error::Violation;
-use margemu_protocol::chip::{ChipModel, ChipSettings, FullScale, SettingsError};
+use margemu_protocol::chip::{
+    ChainConfig, ChipChain, ChipModel, ChipSettings, FullScale, SettingsError,
+};
 use margemu_protocol::link::{AddDevice, Configure, DeviceBus, Rate, RegisterOverride};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 
 /// Chip-select lines a scene may name (a board's SPI target has at most this many).
 pub const MAX_CHIP_SELECTS: u8 = 4;
@@ -86,6 +93,18 @@ pub struct ChipSpec {
     /// Where the chip sits on the plate, m, plate axes, from the plate's reference point (the
     /// lever arm: the chip senses the specific force of that point).
     pub offset: Option<[f64; 3]>,
+    /// `[chip.filters]`: filter register codes by key (`ChainConfig::keys` of the family).
+    pub filters: Option<BTreeMap<String, FilterValue>>,
+}
+
+/// A `[chip.filters]` value: a register code or a flag.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum FilterValue {
+    /// A code.
+    Code(i64),
+    /// A one-bit field.
+    Flag(bool),
 }
 
 /// The chip of a scene, resolved and checked.
@@ -107,6 +126,9 @@ pub struct ChipSetup {
     pub chip_select: u8,
     /// The lever arm, m, plate axes; `None`: at the plate's reference point.
     pub offset: Option<[f64; 3]>,
+    /// The sampling chain's filter settings, checked against the scene's rate (`None`: a
+    /// magnetometer, or the default chip of a scene without `[chip]` at a rate it cannot give).
+    pub chain: Option<ChainConfig>,
 }
 
 impl Default for ChipSetup {
@@ -134,6 +156,7 @@ impl ChipSetup {
             settings: ChipSettings::power_on(model),
             chip_select: 0,
             offset: None,
+            chain: None,
         }
     }
 
@@ -230,9 +253,11 @@ pub fn with_model(scene: &super::Scene, name: &str) -> Result<super::Scene, Stri
     if scene.chip_name == scene.chip.model.name() {
         scene.chip_name = model.name().to_owned();
     }
+    let setup = ChipSetup::power_on(model);
     scene.chip = ChipSetup {
         rotation: scene.chip.rotation,
-        ..ChipSetup::power_on(model)
+        chain: default_chain(&setup.settings, rate),
+        ..setup
     };
     Ok(scene)
 }
@@ -326,7 +351,12 @@ fn settings_of(
 /// Resolves `[chip]` (absent: the default MPU-9250) and checks it against the scene's `rate`.
 pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, Violation> {
     let Some(spec) = spec else {
-        return Ok(ChipSetup::default());
+        // The default chip at any rate: its default chain where that rate has one.
+        let setup = ChipSetup::default();
+        return Ok(ChipSetup {
+            chain: default_chain(&setup.settings, rate),
+            ..setup
+        });
     };
     let model = match &spec.model {
         None => ChipModel::Mpu9250,
@@ -440,7 +470,70 @@ pub(crate) fn resolve(spec: Option<&ChipSpec>, rate: f64) -> Result<ChipSetup, V
         settings,
         chip_select,
         offset: spec.offset.filter(|o| *o != [0.0; 3]),
+        chain: chain_of(spec, &settings, rate)?,
     })
+}
+
+/// The scene's rate as the link's ratio (mHz resolution; the chain rounds periods to ns).
+pub fn link_rate(hz: f64) -> Option<Rate> {
+    let mhz = (hz * 1000.0).round();
+    (mhz >= 1.0 && mhz <= f64::from(u32::MAX)).then(|| Rate::new(mhz as u32, 1000))?
+}
+
+/// The default chain of `settings.model` at `rate`, if it builds there.
+pub fn default_chain(settings: &ChipSettings, rate: f64) -> Option<ChainConfig> {
+    let link = link_rate(rate)?;
+    ChainConfig::default_for(settings.model, link)
+        .filter(|c| ChipChain::new(settings, c, link).is_ok())
+}
+
+/// `[chip.filters]` over the family's defaults at `rate`, checked by building the chain.
+fn chain_of(
+    spec: &ChipSpec,
+    settings: &ChipSettings,
+    rate: f64,
+) -> Result<Option<ChainConfig>, Violation> {
+    let model = settings.model;
+    let part = model.part_name();
+    let link = link_rate(rate)
+        .ok_or_else(|| Violation::at(&["rate"], format!("{rate} Hz is out of range")))?;
+    let Some(default) = ChainConfig::default_for(model, link) else {
+        return match &spec.filters {
+            Some(_) => Err(Violation::at(
+                &["chip", "filters"],
+                format!("the {part} is a magnetometer: it has no filters"),
+            )),
+            None => Ok(None),
+        };
+    };
+    let family = default.family();
+    let keys = ChainConfig::keys(family);
+    let mut values = default.values();
+    for (key, value) in spec.filters.iter().flatten() {
+        let at = |reason: String| {
+            Violation::at_keys(vec!["chip".into(), "filters".into(), key.clone()], reason)
+        };
+        let Some(i) = keys.iter().position(|k| k == key) else {
+            return Err(at(format!(
+                "the {part} takes the filter keys {}",
+                keys.join(", ")
+            )));
+        };
+        let code = match *value {
+            FilterValue::Flag(b) => u8::from(b),
+            FilterValue::Code(c) => {
+                u8::try_from(c).map_err(|_| at(format!("{c} is not a register code (0-255)")))?
+            }
+        };
+        if let Some(slot) = values.get_mut(i) {
+            *slot = code;
+        }
+    }
+    let config = ChainConfig::from_values(family, &values)
+        .ok_or_else(|| Violation::at(&["chip", "filters"], "internal: key count"))?;
+    ChipChain::new(settings, &config, link)
+        .map_err(|e| Violation::at(&["chip", "filters"], e.to_string()))?;
+    Ok(Some(config))
 }
 
 fn check_rotation(r: &Rotation) -> Result<(), Violation> {

@@ -28,8 +28,8 @@ pub mod rig;
 mod schema;
 pub mod sensors;
 pub mod size;
-pub mod vibration;
 mod validate;
+pub mod vibration;
 mod warnings;
 
 pub use error::{SceneError, SceneWarning};
@@ -91,7 +91,7 @@ impl Scene {
             .into_iter()
             .map(|v| SceneWarning(SceneError::from_violation(path, text, v)))
             .collect();
-        let scene = Self {
+        let mut scene = Self {
             spec,
             path: path.to_path_buf(),
             text: text.to_owned(),
@@ -106,7 +106,34 @@ impl Scene {
             warnings,
         };
         scene.check_gains()?;
+        scene.resolve_vibration()?;
         Ok(scene)
+    }
+
+    /// Fills [`Scene::vibration`] and [`Scene::sampling`] from `[vibration]`, and adds its
+    /// warnings.
+    fn resolve_vibration(&mut self) -> Result<(), SceneError> {
+        let devices = self.devices();
+        let (spec, located) = (&self.spec, |v| {
+            SceneError::from_violation(&self.path, &self.text, v)
+        });
+        let per_device = vibration::resolve(&spec.vibration, &devices, spec.rate, self.base_dir())
+            .map_err(located)?;
+        let warnings = vibration::warnings(
+            &spec.vibration,
+            &devices,
+            &per_device,
+            spec.rate,
+            spec.duration,
+        );
+        let warnings: Vec<_> = warnings
+            .into_iter()
+            .map(|v| SceneWarning(located(v)))
+            .collect();
+        self.sampling = spec.vibration.path;
+        self.vibration = per_device;
+        self.warnings.extend(warnings);
+        Ok(())
     }
 
     /// Every device of the scene's rig, device 0 ([`Scene::chip`]) first.

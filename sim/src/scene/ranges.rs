@@ -77,6 +77,19 @@ pub const TEMPERATURE_SLOPE: Plausible = range(-1e3, 1e3, "°C/s");
 /// `perturbation.amplitude`.
 pub const PERTURBATION_AMPLITUDE: Plausible = range(0.0, 1e6, "field unit");
 
+/// Motor speeds of `[[vibration.tones]]` (`rpm`, ramps, steps, CSV rows).
+pub const RPM: Plausible = range(0.0, 1e6, "rpm");
+/// Harmonic orders of `[[vibration.tones.harmonics]]`.
+pub const HARMONIC_ORDER: Plausible = range(0.0, 1e3, "");
+/// Linear vibration amplitudes (tone harmonics, shock peaks).
+pub const VIBRATION_LINEAR: Plausible = range(-1e6, 1e6, "m/s²");
+/// Angular vibration amplitudes (tone harmonics, shock peaks).
+pub const VIBRATION_ANGULAR: Plausible = range(-1e4, 1e4, "rad/s");
+/// Random vibration PSD values.
+pub const PSD_VALUE: Plausible = range(0.0, 1e6, "g²/Hz");
+/// Random vibration `gains`.
+pub const VIBRATION_GAIN: Plausible = range(0.0, 1e3, "");
+
 impl Plausible {
     /// Whether `x` lies in the range.
     pub fn contains(&self, x: f64) -> bool {
@@ -165,6 +178,12 @@ mod tests {
             TEMPERATURE,
             TEMPERATURE_SLOPE,
             PERTURBATION_AMPLITUDE,
+            RPM,
+            HARMONIC_ORDER,
+            VIBRATION_LINEAR,
+            VIBRATION_ANGULAR,
+            PSD_VALUE,
+            VIBRATION_GAIN,
         ];
         for range in all {
             let cell = format!("| {} |", range.describe());

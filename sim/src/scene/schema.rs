@@ -57,6 +57,9 @@ pub struct SceneSpec {
     /// The devices of a rig (`[[device]]`), instead of `[chip]`.
     #[serde(default)]
     pub device: Vec<super::chip::ChipSpec>,
+    /// Vibration: motor tones, random vibration, shocks (`[vibration]`); none when absent.
+    #[serde(default)]
+    pub vibration: super::vibration::VibrationSpec,
 }
 
 /// How the plate's motion is produced; a scene pays only for the mode it names.

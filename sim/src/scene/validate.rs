@@ -324,7 +324,7 @@ fn check_joint(name: &str, source: &SourceSpec, motion: MotionMode) -> Check {
     }
 }
 
-fn positive_nanos(s: f64, at: &[&str], range: Plausible) -> Result<Nanos, Violation> {
+pub(crate) fn positive_nanos(s: f64, at: &[&str], range: Plausible) -> Result<Nanos, Violation> {
     finite_positive(s, at, range)?;
     match nanos_from_seconds(s) {
         Some(ns) if ns > 0 => Ok(ns),
@@ -344,7 +344,7 @@ pub(crate) fn finite(x: f64, at: &[&str], range: Plausible) -> Check {
     }
 }
 
-fn finite_positive(x: f64, at: &[&str], range: Plausible) -> Check {
+pub(crate) fn finite_positive(x: f64, at: &[&str], range: Plausible) -> Check {
     if x.is_finite() && x > 0.0 {
         range.check(x, at)
     } else {

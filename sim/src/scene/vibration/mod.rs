@@ -1,15 +1,42 @@
 //! Vibration in scenes: `[vibration]` and its `tones`, `random` and `shocks` sources, resolved
-//! per device (CONTRACT: the types below are fixed; the parsing lands with the scene schema).
+//! per device.
 //!
 //! Every source is given in plate axes and reaches every device, or only the device its
 //! `device` key names; [`DeviceVibration`] holds what reaches one device, already turned into
-//! that device's chip axes (tone and shock amplitudes rotated; the random source carries the
-//! rotation in [`RandomSource::axes`]).
+//! that device's chip axes (tone and shock amplitudes rotated by the device's mounting
+//! rotation; the random source keeps its gains in plate axes and carries the rotation in
+//! [`RandomSource::axes`]). Times become integer nanoseconds (rounded to the nearest). The
+//! schema is [`VibrationSpec`]; the user guide (`docs/scene-files.md`, "Vibration") lists every
+//! key. Every refusal is located at the offending key; an `rpm_csv` problem also names the CSV
+//! file and line.
+//!
+//! ```
+//! let text = "duration = 1.0\nrate = 1000.0\nseed = 1\nmotion = \"static\"\n\
+//!     [[vibration.tones]]\nmotors = 2\nrpm_ramp = { from = 6000, to = 12000, start = 0.5, end = 1.0 }\n\
+//!     [[vibration.tones.harmonics]]\norder = 1.0\nlinear = [0.0, 0.0, 3.0]\n";
+//! let scene = margemu_sim::scene::Scene::parse_str(text, std::path::Path::new("v.toml")).unwrap();
+//! let tone = &scene.vibration[0].tones[0];
+//! assert_eq!(tone.profile[1].t_ns, 1_000_000_000);
+//! assert_eq!(tone.harmonics()[0].linear, [0.0, 0.0, 3.0]);
+//! assert_eq!(tone.max_frequency_hz(), 200.0);
+//! ```
+
+mod at;
+mod resolve;
+mod rpm;
+mod spec;
+mod warn;
+
+pub(crate) use resolve::resolve;
+pub use resolve::CHECK_RATE_HZ;
+pub use spec::{HarmonicSpec, RampSpec, RandomSpec, ShockSpec, ToneSpec, VibrationSpec};
+pub(crate) use warn::collect as warnings;
 
 use margemu_model::vibration::{RandomSource, RpmPoint, Shock, ToneSource};
 
-/// Where a device's chain runs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Where a device's chain runs (`[vibration] path`: `"auto"`, `"internal"`, `"output"`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum SamplingPath {
     /// The internal-rate path when some vibration reaching the device has content above the
     /// output Nyquist frequency ([`DeviceVibration::max_frequency_hz`]), else the output path.
