@@ -117,3 +117,35 @@ fn case_names_are_family_slash_path() {
     assert_eq!(names[8], "icm42688p/internal+tones+shock");
     assert_eq!(names[19], "bmi088/internal+random");
 }
+
+#[test]
+fn each_family_runs_its_declared_chain() {
+    for family in Family::ALL {
+        let declared = family
+            .declared()
+            .unwrap_or_else(|e| panic!("{family}: {e}"));
+        assert_eq!(
+            declared.output_period_ns,
+            family.output_period_ns(),
+            "{family}"
+        );
+        assert_eq!(
+            [declared.accel.period_ns, declared.gyro.period_ns],
+            family.internal_periods_ns(),
+            "{family}"
+        );
+        // The widest full scales: 16 g (24 g) and 2000 °/s.
+        let g = if family == Family::Bmi088 { 24.0 } else { 16.0 };
+        assert!(
+            (declared.accel.range - g * 9.806_65).abs() < 1e-3,
+            "{family}"
+        );
+        assert!(
+            (declared.gyro.range - 2000f32.to_radians()).abs() < 1e-5,
+            "{family}"
+        );
+        // Real filters: below unity gain well inside the internal Nyquist band.
+        let nyquist = 0.45e9 / declared.gyro.period_ns as f64;
+        assert!(declared.gyro.filter.gain_at(nyquist) < 0.9, "{family}");
+    }
+}

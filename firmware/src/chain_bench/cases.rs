@@ -1,16 +1,15 @@
 //! The cases' chips, paths and vibration.
 //!
-//! Each family runs at the output rate flight controllers use it at, with the internal rates
-//! its datasheet gives for that configuration (ICM-20602, DS-000176 section 10.2: gyro 8 kHz
-//! with DLPF_CFG 0, accelerometer 4 kHz with ACCEL_FCHOICE_B = 1; ICM-42688-P, DS-000347
-//! section 5.3: both sensors sample at 32 kHz; BMI270, BST-BMI270-DS000: gyro 3.2 kHz,
-//! accelerometer at most 1.6 kHz; BMI088, BST-BMI088-DS001: gyro 2 kHz, accelerometer at most
-//! 1.6 kHz), and the widest full scales (16 g, 24 g for the BMI088; 2000 °/s). The filters are
-//! the identity until the chips' declared chains land.
+//! Each family runs at the output rate flight controllers use it at, with its declared chain
+//! ([`ChipChain`]: internal rates, filters as [`ChainConfig::default_for`] that rate) at the
+//! widest full scales (16 g, 24 g for the BMI088; 2000 °/s). The internal rates
+//! ([`Family::internal_periods_ns`], checked against the declared chain by the tests): the
+//! ICM-20602's ADC at 8 kHz (gyro) and 4 kHz (accelerometer, ACCEL_FCHOICE_B = 1); the
+//! ICM-42688-P's both at 32 kHz; the BMI270's gyro at 3.2 kHz, accelerometer at 1.6 kHz; the
+//! BMI088's gyro at 2 kHz, accelerometer at 1.6 kHz.
 
 use core::fmt;
 
-use margemu_model::chain::filter::FilterDesign;
 use margemu_model::chain::{DeviceChain, SensorPath};
 use margemu_model::perturbation::Complex;
 use margemu_model::sensor::MargConfig;
@@ -18,9 +17,11 @@ use margemu_model::vibration::{
     Harmonic, PsdPoint, RandomSource, RpmPoint, Sense, Shock, ToneSource, Vibration,
 };
 use margemu_model::Error;
-use margemu_protocol::chip::{ChipModel, ChipSettings, FullScale};
+use margemu_protocol::chip::{ChainConfig, ChipChain, ChipModel, ChipSettings, FullScale};
+use margemu_protocol::chip::{ChainError, SensorChain};
+use margemu_protocol::link::Rate;
 
-use super::{Case, DURATION_NS, SEED};
+use super::{BenchError, Case, DURATION_NS, SEED};
 
 /// Complex values of random-vibration buffer the largest [`Path::InternalRandom`] case needs
 /// (the ICM-42688-P's 32 kHz accelerometer: 5120-point blocks; 16 bytes each, 560 KiB).
@@ -81,24 +82,20 @@ impl Family {
         }
     }
 
-    /// The full scales (accelerometer m/s², gyroscope rad/s).
-    fn ranges(self) -> Result<[f32; 2], Error> {
+    /// The chip's declared chain at its output rate: the family's default filter settings at
+    /// that rate, the widest full scales.
+    pub fn declared(self) -> Result<ChipChain, BenchError> {
+        let model = self.model();
+        let hz = (1e9 / self.output_period_ns() as f64) as u32;
+        let rate = Rate::hz(hz).ok_or(ChainError::NoChain { model })?;
+        let config = ChainConfig::default_for(model, rate).ok_or(ChainError::NoChain { model })?;
         let accel_g = if self == Self::Bmi088 { 24.0 } else { 16.0 };
         let fs = FullScale {
             accel_g,
             gyro_dps: 2000.0,
         };
-        let settings = ChipSettings::with_full_scale(self.model(), fs);
-        let fs = settings
-            .ok()
-            .and_then(|s| s.full_scale())
-            .ok_or(Error::NonPositiveParameter {
-                what: "chain.range",
-            })?;
-        Ok([
-            (fs.accel_g * 9.806_65) as f32,
-            fs.gyro_dps.to_radians() as f32,
-        ])
+        let settings = ChipSettings::with_full_scale(model, fs).map_err(BenchError::Settings)?;
+        Ok(ChipChain::new(&settings, &config, rate)?)
     }
 }
 
@@ -228,24 +225,24 @@ pub(super) fn noise() -> MargConfig {
 }
 
 /// The chain of `case`, `buffer` lent to the accelerometer's random synthesis if it has one.
-pub(super) fn chain<'a>(case: &Case, buffer: &'a mut [Complex]) -> Result<BenchChain<'a>, Error> {
-    let family = case.family;
-    let [accel_range, gyro_range] = family.ranges()?;
-    let [accel_ns, gyro_ns] = family.internal_periods_ns();
-    let accel = path(case, Sense::Linear, accel_ns, accel_range, Some(buffer))?;
-    let gyro = path(case, Sense::Angular, gyro_ns, gyro_range, None)?;
+pub(super) fn chain<'a>(
+    case: &Case,
+    buffer: &'a mut [Complex],
+) -> Result<BenchChain<'a>, BenchError> {
+    let declared = case.family.declared()?;
+    let accel = path(case, Sense::Linear, &declared.accel, Some(buffer))?;
+    let gyro = path(case, Sense::Angular, &declared.gyro, None)?;
     Ok(DeviceChain { accel, gyro })
 }
 
 fn path<'a>(
     case: &Case,
     sense: Sense,
-    internal_ns: u64,
-    range: f32,
+    declared: &SensorChain,
     buffer: Option<&'a mut [Complex]>,
 ) -> Result<BenchPath<'a>, Error> {
     let period = match case.path.is_internal() {
-        true => internal_ns,
+        true => declared.period_ns,
         false => case.family.output_period_ns(),
     };
     let mut vibration = Vibration::new(sense, period, SEED);
@@ -263,10 +260,9 @@ fn path<'a>(
         }
     }
     if case.path.is_internal() {
-        let filter = FilterDesign::identity(1e9 / internal_ns as f64)?;
-        SensorPath::new(internal_ns, filter, range, vibration)
+        SensorPath::new(period, declared.filter, declared.range, vibration)
     } else {
-        SensorPath::at_output(range, vibration)
+        SensorPath::at_output(declared.range, vibration)
     }
 }
 

@@ -4,7 +4,8 @@
 //! bits.
 //!
 //! A [`Case`] is a chip family ([`Family`]: ICM-20602 at 8 kHz, ICM-42688-P at 8 kHz with its
-//! 32 kHz internal rate, BMI270 at 3.2 kHz, BMI088 at 2 kHz) and a [`Path`] through the chain
+//! 32 kHz internal rate, BMI270 at 3.2 kHz, BMI088 at 2 kHz, each with its declared chain
+//! [`Family::declared`]: internal rates, filters, full scales) and a [`Path`] through the chain
 //! (the output path or the internal path, without vibration, with motor tones, with tones and
 //! a shock, with random vibration). [`run`] builds the case's
 //! [`DeviceChain`](margemu_model::chain::DeviceChain) and a
@@ -43,6 +44,7 @@ use core::fmt;
 use margemu_model::perturbation::Complex;
 use margemu_model::sensor::{Marg, Truth};
 use margemu_model::vec3::Vec3;
+use margemu_protocol::chip::{ChainError, SettingsError};
 
 /// Seconds of truth each case runs.
 pub const DURATION_NS: u64 = 500_000_000;
@@ -112,12 +114,18 @@ pub enum BenchError {
     /// The model refused a part of the case (a vibration source, the sensor model, or the
     /// random-vibration buffer is too small).
     Model(margemu_model::Error),
+    /// The chip's declared chain could not be built.
+    Chain(ChainError),
+    /// The chip has no such full scale.
+    Settings(SettingsError),
 }
 
 impl fmt::Display for BenchError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Model(e) => write!(f, "chain bench: {e}"),
+            Self::Chain(e) => write!(f, "chain bench: {e}"),
+            Self::Settings(e) => write!(f, "chain bench: full scale: {e:?}"),
         }
     }
 }
@@ -127,6 +135,12 @@ impl core::error::Error for BenchError {}
 impl From<margemu_model::Error> for BenchError {
     fn from(e: margemu_model::Error) -> Self {
         Self::Model(e)
+    }
+}
+
+impl From<ChainError> for BenchError {
+    fn from(e: ChainError) -> Self {
+        Self::Chain(e)
     }
 }
 
