@@ -49,11 +49,23 @@ pub fn welch(x: &[f64], rate_hz: f64, n: usize) -> Vec<f64> {
 #[test]
 fn a_constant_tone_has_its_frequency_and_amplitude_per_motor() {
     // 9000 rpm = 150 Hz, 2nd harmonic 300 Hz; two motors without spread, random phases.
-    let profile = [RpmPoint { t_ns: 0, rpm: 9000.0 }];
+    let profile = [RpmPoint {
+        t_ns: 0,
+        rpm: 9000.0,
+    }];
     let mut tone = ToneSource::new(1, &profile[..]);
-    tone.push(Harmonic { order: 1.0, linear: [0.0, 0.0, 2.0], angular: [0.1, 0.0, 0.0] })
-        .unwrap();
-    tone.push(Harmonic { order: 2.0, linear: [1.0, 0.0, 0.0], angular: [0.0; 3] }).unwrap();
+    tone.push(Harmonic {
+        order: 1.0,
+        linear: [0.0, 0.0, 2.0],
+        angular: [0.1, 0.0, 0.0],
+    })
+    .unwrap();
+    tone.push(Harmonic {
+        order: 2.0,
+        linear: [1.0, 0.0, 0.0],
+        angular: [0.0; 3],
+    })
+    .unwrap();
     let mut vib: Vib = Vibration::new(Sense::Linear, 250_000, 3);
     vib.add_tones(tone).unwrap();
     let x: Vec<[f32; 3]> = (0..4000u64).map(|k| vib.next(k * 250_000)).collect();
@@ -64,8 +76,12 @@ fn a_constant_tone_has_its_frequency_and_amplitude_per_motor() {
     assert!(axis(1).iter().all(|v| *v == 0.0));
     // The gyroscope's sense takes the angular amplitudes.
     let mut tone = ToneSource::new(1, &profile[..]);
-    tone.push(Harmonic { order: 1.0, linear: [0.0, 0.0, 2.0], angular: [0.1, 0.0, 0.0] })
-        .unwrap();
+    tone.push(Harmonic {
+        order: 1.0,
+        linear: [0.0, 0.0, 2.0],
+        angular: [0.1, 0.0, 0.0],
+    })
+    .unwrap();
     let mut gyro: Vib = Vibration::new(Sense::Angular, 125_000, 3);
     gyro.add_tones(tone).unwrap();
     let g: Vec<f32> = (0..8000u64).map(|k| gyro.next(k * 125_000)[0]).collect();
@@ -75,39 +91,77 @@ fn a_constant_tone_has_its_frequency_and_amplitude_per_motor() {
 #[test]
 fn motors_with_spread_beat_and_a_ramp_sweeps() {
     // Four motors at ±5 % around 6000 rpm: four tones between 95 and 105 Hz, not one.
-    let profile = [RpmPoint { t_ns: 0, rpm: 6000.0 }];
+    let profile = [RpmPoint {
+        t_ns: 0,
+        rpm: 6000.0,
+    }];
     let mut tone = ToneSource::new(4, &profile[..]);
     tone.spread = 0.05;
-    tone.push(Harmonic { order: 1.0, linear: [1.0, 0.0, 0.0], angular: [0.0; 3] }).unwrap();
+    tone.push(Harmonic {
+        order: 1.0,
+        linear: [1.0, 0.0, 0.0],
+        angular: [0.0; 3],
+    })
+    .unwrap();
     let mut vib: Vib = Vibration::new(Sense::Linear, 250_000, 11);
     vib.add_tones(tone).unwrap();
     let x: Vec<f32> = (0..40_000u64).map(|k| vib.next(k * 250_000)[0]).collect();
     let peak = (0..40_000).map(|i| x[i].abs()).fold(0.0f32, f32::max);
-    assert!(peak > 2.0 && peak <= 4.0, "four motors add up to at most 4: {peak}");
-    assert!(amplitude_at(&x, 100.0, 4000.0) < 0.9, "spread moves them off 100 Hz");
+    assert!(
+        peak > 2.0 && peak <= 4.0,
+        "four motors add up to at most 4: {peak}"
+    );
+    assert!(
+        amplitude_at(&x, 100.0, 4000.0) < 0.9,
+        "spread moves them off 100 Hz"
+    );
     // A ramp 0 → 12 000 rpm over 1 s: the zero crossings get denser.
     let ramp = [
         RpmPoint { t_ns: 0, rpm: 0.0 },
-        RpmPoint { t_ns: 1_000_000_000, rpm: 12_000.0 },
+        RpmPoint {
+            t_ns: 1_000_000_000,
+            rpm: 12_000.0,
+        },
     ];
     let mut tone = ToneSource::new(1, &ramp[..]);
-    tone.push(Harmonic { order: 1.0, linear: [1.0, 0.0, 0.0], angular: [0.0; 3] }).unwrap();
+    tone.push(Harmonic {
+        order: 1.0,
+        linear: [1.0, 0.0, 0.0],
+        angular: [0.0; 3],
+    })
+    .unwrap();
     let mut vib: Vib = Vibration::new(Sense::Linear, 100_000, 1);
     vib.add_tones(tone).unwrap();
     let x: Vec<f32> = (0..10_000u64).map(|k| vib.next(k * 100_000)[0]).collect();
-    let crossings = |s: &[f32]| s.windows(2).filter(|w| (w[0] < 0.0) != (w[1] < 0.0)).count();
+    let crossings = |s: &[f32]| {
+        s.windows(2)
+            .filter(|w| (w[0] < 0.0) != (w[1] < 0.0))
+            .count()
+    };
     // Phase = ∫ 200 t dt = 100 t² cycles: 25 cycles in the first half second, 75 in the second.
     let (first, second) = (crossings(&x[..5000]), crossings(&x[5000..]));
-    assert!((first as i64 - 50).abs() <= 2 && (second as i64 - 150).abs() <= 2, "{first} {second}");
+    assert!(
+        (first as i64 - 50).abs() <= 2 && (second as i64 - 150).abs() <= 2,
+        "{first} {second}"
+    );
 }
 
 #[test]
 fn a_random_source_has_its_psd() {
     // 30..1500 Hz, rising 3 dB/octave to 200 Hz then flat, at 4 kHz.
     let psd = [
-        PsdPoint { f_hz: 30.0, g2_per_hz: 0.002 },
-        PsdPoint { f_hz: 200.0, g2_per_hz: 0.0133 },
-        PsdPoint { f_hz: 1500.0, g2_per_hz: 0.0133 },
+        PsdPoint {
+            f_hz: 30.0,
+            g2_per_hz: 0.002,
+        },
+        PsdPoint {
+            f_hz: 200.0,
+            g2_per_hz: 0.0133,
+        },
+        PsdPoint {
+            f_hz: 1500.0,
+            g2_per_hz: 0.0133,
+        },
     ];
     let source = RandomSource::new(&psd).unwrap();
     let rate = 4000.0;
@@ -132,7 +186,11 @@ fn a_random_source_has_its_psd() {
         }
     }
     // Axes are independent: the correlation of x and y is near zero.
-    let c: f64 = x.iter().map(|v| f64::from(v[0]) * f64::from(v[1])).sum::<f64>() / n as f64;
+    let c: f64 = x
+        .iter()
+        .map(|v| f64::from(v[0]) * f64::from(v[1]))
+        .sum::<f64>()
+        / n as f64;
     let vx: f64 = x.iter().map(|v| f64::from(v[0]).powi(2)).sum::<f64>() / n as f64;
     assert!((c / vx).abs() < 0.02, "x-y correlation {}", c / vx);
 }
@@ -153,26 +211,45 @@ fn a_shock_is_a_half_sine() {
     assert!((z[15] - 100.0 * (std::f32::consts::PI / 4.0).sin()).abs() < 1e-4);
     let mut gyro: Vib = Vibration::new(Sense::Angular, 100_000, 0);
     gyro.add_shock(&shock).unwrap();
-    assert_eq!((0..21u64).map(|k| gyro.next(k * 100_000)).last().unwrap(), [1.0, 0.0, 0.0]);
+    assert_eq!(
+        (0..21u64).map(|k| gyro.next(k * 100_000)).last().unwrap(),
+        [1.0, 0.0, 0.0]
+    );
 }
 
 #[test]
 fn the_same_seed_gives_the_same_bits_and_another_seed_others() {
     let run = |seed: u64| {
         let psd = [
-            PsdPoint { f_hz: 50.0, g2_per_hz: 0.01 },
-            PsdPoint { f_hz: 800.0, g2_per_hz: 0.01 },
+            PsdPoint {
+                f_hz: 50.0,
+                g2_per_hz: 0.01,
+            },
+            PsdPoint {
+                f_hz: 800.0,
+                g2_per_hz: 0.01,
+            },
         ];
         let source = RandomSource::new(&psd).unwrap();
-        let profile = [RpmPoint { t_ns: 0, rpm: 10_000.0 }];
+        let profile = [RpmPoint {
+            t_ns: 0,
+            rpm: 10_000.0,
+        }];
         let mut tone = ToneSource::new(2, &profile[..]);
         tone.spread = 0.01;
-        tone.push(Harmonic { order: 1.0, linear: [1.0; 3], angular: [0.0; 3] }).unwrap();
+        tone.push(Harmonic {
+            order: 1.0,
+            linear: [1.0; 3],
+            angular: [0.0; 3],
+        })
+        .unwrap();
         let mut vib: Vib = Vibration::new(Sense::Linear, 250_000, seed);
         vib.add_tones(tone).unwrap();
         let buffers = vec![Complex::ZERO; source.buffer_len(4000.0).unwrap()];
         vib.add_random(&source, buffers).unwrap();
-        (0..5000u64).map(|k| vib.next(k * 250_000)).collect::<Vec<_>>()
+        (0..5000u64)
+            .map(|k| vib.next(k * 250_000))
+            .collect::<Vec<_>>()
     };
     assert_eq!(run(9), run(9));
     assert_ne!(run(9), run(10));
@@ -187,27 +264,71 @@ fn bad_sources_are_refused() {
         Err(Error::InvalidRpmProfile)
     );
     let profile = [RpmPoint { t_ns: 0, rpm: 1.0 }];
-    assert_eq!(vib.add_tones(ToneSource::new(0, &profile[..])), Err(Error::InvalidMotorCount));
-    let back = [RpmPoint { t_ns: 5, rpm: 1.0 }, RpmPoint { t_ns: 4, rpm: 1.0 }];
-    assert_eq!(vib.add_tones(ToneSource::new(1, &back[..])), Err(Error::InvalidRpmProfile));
-    let flat = [PsdPoint { f_hz: 10.0, g2_per_hz: 1.0 }, PsdPoint { f_hz: 10.0, g2_per_hz: 1.0 }];
+    assert_eq!(
+        vib.add_tones(ToneSource::new(0, &profile[..])),
+        Err(Error::InvalidMotorCount)
+    );
+    let back = [
+        RpmPoint { t_ns: 5, rpm: 1.0 },
+        RpmPoint { t_ns: 4, rpm: 1.0 },
+    ];
+    assert_eq!(
+        vib.add_tones(ToneSource::new(1, &back[..])),
+        Err(Error::InvalidRpmProfile)
+    );
+    let flat = [
+        PsdPoint {
+            f_hz: 10.0,
+            g2_per_hz: 1.0,
+        },
+        PsdPoint {
+            f_hz: 10.0,
+            g2_per_hz: 1.0,
+        },
+    ];
     assert_eq!(RandomSource::new(&flat), Err(Error::InvalidPsd));
-    let low = [PsdPoint { f_hz: 0.1, g2_per_hz: 1.0 }, PsdPoint { f_hz: 10.0, g2_per_hz: 1.0 }];
-    assert_eq!(RandomSource::new(&low).unwrap().fft_len(32_000.0), Err(Error::PsdTooFine));
+    let low = [
+        PsdPoint {
+            f_hz: 0.1,
+            g2_per_hz: 1.0,
+        },
+        PsdPoint {
+            f_hz: 10.0,
+            g2_per_hz: 1.0,
+        },
+    ];
+    assert_eq!(
+        RandomSource::new(&low).unwrap().fft_len(32_000.0),
+        Err(Error::PsdTooFine)
+    );
     let ok = RandomSource::new(&[
-        PsdPoint { f_hz: 20.0, g2_per_hz: 1.0 },
-        PsdPoint { f_hz: 100.0, g2_per_hz: 1.0 },
+        PsdPoint {
+            f_hz: 20.0,
+            g2_per_hz: 1.0,
+        },
+        PsdPoint {
+            f_hz: 100.0,
+            g2_per_hz: 1.0,
+        },
     ])
     .unwrap();
     let mut gyro: Vib = Vibration::new(Sense::Angular, 250_000, 0);
-    assert_eq!(gyro.add_random(&ok, vec![]), Err(Error::RandomVibrationNotLinear));
+    assert_eq!(
+        gyro.add_random(&ok, vec![]),
+        Err(Error::RandomVibrationNotLinear)
+    );
     assert!(matches!(
         vib.add_random(&ok, vec![Complex::ZERO; 3]),
         Err(Error::BufferTooSmall { .. })
     ));
     assert_eq!(
-        vib.add_shock(&Shock { duration_ns: 0, ..Shock::default() }),
-        Err(Error::NonPositiveParameter { what: "vibration.shock.duration" })
+        vib.add_shock(&Shock {
+            duration_ns: 0,
+            ..Shock::default()
+        }),
+        Err(Error::NonPositiveParameter {
+            what: "vibration.shock.duration"
+        })
     );
     assert!(vib.is_empty());
 }

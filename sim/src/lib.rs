@@ -35,7 +35,7 @@ pub mod output;
 pub mod quat;
 pub mod reference;
 pub mod run;
-pub mod sampling;
 pub mod rundir;
+pub mod sampling;
 pub mod scene;
 pub mod truth;

@@ -156,7 +156,9 @@ impl MargSim {
 
     /// Whether the device's chain runs at the chip's internal rate.
     pub fn runs_internal_path(&self) -> bool {
-        self.chain.as_ref().is_some_and(|c| c.accel.period_ns() != 0)
+        self.chain
+            .as_ref()
+            .is_some_and(|c| c.accel.period_ns() != 0)
     }
 
     /// Whether the scene has a perturbation generator.

@@ -29,10 +29,17 @@ fn tone_through(
     warmup: usize,
     n: usize,
 ) -> Vec<f64> {
-    let profile = vec![RpmPoint { t_ns: 0, rpm: f_hz * 60.0 }];
+    let profile = vec![RpmPoint {
+        t_ns: 0,
+        rpm: f_hz * 60.0,
+    }];
     let mut tone = ToneSource::new(1, profile);
-    tone.push(Harmonic { order: 1.0, linear: [0.0; 3], angular: [amplitude, 0.0, 0.0] })
-        .unwrap();
+    tone.push(Harmonic {
+        order: 1.0,
+        linear: [0.0; 3],
+        angular: [amplitude, 0.0, 0.0],
+    })
+    .unwrap();
     let mut path: SensorPath<Vec<RpmPoint>, Vec<Complex>> = match spec {
         Some(s) => {
             let mut vib = Vibration::new(Sense::Angular, s.period_ns, 1);
@@ -75,7 +82,14 @@ fn folds_as_predicted(model: ChipModel, hz: u32, config: Option<ChainConfig>, de
     let amplitude = 0.5 * f64::from(c.gyro.range);
     let dt = c.output_period_ns as f64 * 1e-9;
     let n = (odr / delta).round() as usize * 10;
-    let out = tone_through(Some(&c.gyro), c.output_period_ns, f, amplitude, hz as usize, n);
+    let out = tone_through(
+        Some(&c.gyro),
+        c.output_period_ns,
+        f,
+        amplitude,
+        hz as usize,
+        n,
+    );
     let (re, im) = phasor(&out, delta, dt);
     let got = (re * re + im * im).sqrt();
     let predicted = amplitude * c.gyro.filter.gain_at(f);

@@ -56,9 +56,8 @@ impl DeviceModel {
         let front = match chip.settings().front_end_ranges() {
             None => None,
             Some([accel, gyro]) => {
-                let path = |sense, range| {
-                    SensorPath::at_output(range, Vibration::new(sense, 1, seed))
-                };
+                let path =
+                    |sense, range| SensorPath::at_output(range, Vibration::new(sense, 1, seed));
                 Some(DeviceChain {
                     accel: path(Sense::Linear, accel)?,
                     gyro: path(Sense::Angular, gyro)?,

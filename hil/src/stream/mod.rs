@@ -76,8 +76,8 @@
 //! ([`log`], written by their own thread) are flushed and end with an `end` row in
 //! `events.csv`.
 
-pub mod clock;
 pub mod clipping;
+pub mod clock;
 pub mod device_truth;
 mod ending;
 mod flow;

@@ -75,7 +75,9 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> SensorPath<P,
             return Err(Error::InvalidRate);
         }
         if range.is_nan() || range <= 0.0 {
-            return Err(Error::NonPositiveParameter { what: "chain.range" });
+            return Err(Error::NonPositiveParameter {
+                what: "chain.range",
+            });
         }
         Ok(Self {
             period_ns,
@@ -118,9 +120,15 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> SensorPath<P,
         self.output
     }
 
-    /// One internal sample at `t_ns`.
+    /// One internal sample at `t_ns`. The first one settles the filters on the rigid-body
+    /// input first (the chip has been on long before the scene starts: no start-up transient).
     #[inline]
     fn step(&mut self, t_ns: u64, input: Vec3) {
+        if self.next == 0 {
+            for (state, x) in self.states.iter_mut().zip(input) {
+                self.filter.settle(state, x.clamp(-self.range, self.range));
+            }
+        }
         let v = self.vibration.next(t_ns);
         let mut y = [0.0f32; 3];
         for (i, ((x, v), y)) in input.iter().zip(v).zip(&mut y).enumerate() {
@@ -173,7 +181,9 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> DeviceChain<P
     pub fn sample(&mut self, marg: &mut Marg, t_ns: u64, truth: &Truth) -> Sample {
         let f = marg.accel().specific_force_at_sensor(truth);
         let a = self.accel.advance(t_ns, f);
-        let w = self.gyro.advance(t_ns, clamp(truth.angular_rate, INPUT_LIMIT));
+        let w = self
+            .gyro
+            .advance(t_ns, clamp(truth.angular_rate, INPUT_LIMIT));
         marg.sample_chained(truth, a, w)
     }
 }

@@ -67,7 +67,10 @@ impl<P: AsRef<[RpmPoint]>> ToneSource<P> {
 
     /// Changes every harmonic with `f` (e.g. to turn its amplitudes into other axes).
     pub fn map_harmonics(&mut self, f: impl FnMut(&mut Harmonic)) {
-        self.harmonics.iter_mut().take(self.harmonic_count).for_each(f);
+        self.harmonics
+            .iter_mut()
+            .take(self.harmonic_count)
+            .for_each(f);
     }
 
     /// Whether some harmonic has an amplitude in `sense`.
