@@ -27,4 +27,5 @@ pub use margemu_sim::{
 pub mod demo;
 pub mod own_files;
 pub mod perf;
+pub mod perf_chain;
 pub mod vfc_score;

@@ -213,10 +213,10 @@ fn errors_name_what_was_wrong() {
         .unwrap_err();
     assert_eq!(e, Error::FilterRateMismatch);
     let e = eight.with_delay(MAX_DELAY + 1).unwrap_err();
-    assert_eq!(e, Error::FilterDelayTooLong { samples: 65 });
+    assert_eq!(e, Error::FilterDelayTooLong { samples: 161 });
     assert_eq!(
         e.to_string(),
-        "filter delay of 65 samples exceeds 64 samples"
+        "filter delay of 161 samples exceeds 160 samples"
     );
     assert!(eight.with_delay(MAX_DELAY).is_ok());
 }

@@ -18,7 +18,7 @@
 //!   windowed overlap-add of inverse FFTs ([`random`]); per-axis gains; linear only.
 //! - **Shocks** ([`Shock`]): half-sine pulses `peak · sin(π (t − t₀)/d)` for `t₀ ≤ t < t₀ + d`.
 //!
-//! Determinism: the tones and shocks run in `f32` with a fixed order of operations and `libm`; the
+//! Determinism: the tones and shocks run in `f32` with a fixed order of operations ([`sine`]); the
 //! random synthesis runs in `f64` (the model's FFT) and rounds each sample to `f32`. Random draws
 //! come from the streams `vibration/tones/<i>` (phases and spreads, at construction) and
 //! `vibration/random` (per block), so the host and the firmware give the same bits.
@@ -36,6 +36,7 @@
 //! ```
 
 pub mod random;
+pub mod sine;
 mod tones;
 
 pub use random::{PsdPoint, RandomSource, MAX_PSD_POINTS};
@@ -169,7 +170,7 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> Vibration<P, 
         }
         for &(t0, d, peak) in self.shocks.iter().take(self.shock_count) {
             if let Some(into) = t_ns.checked_sub(t0).filter(|&dt| dt < d) {
-                let s = libm::sinf(core::f32::consts::PI * (into as f32 / d as f32));
+                let s = sine::sin_cycles(0.5 * (into as f32 / d as f32));
                 v = add(v, [peak[0] * s, peak[1] * s, peak[2] * s]);
             }
         }

@@ -220,7 +220,7 @@ impl<P: AsRef<[RpmPoint]>> Tones<P> {
                 .zip(&self.amplitudes)
                 .take(n)
             {
-                let s = libm::sinf(core::f32::consts::TAU * *p);
+                let s = super::sine::sin_cycles(*p);
                 v = [v[0] + amp[0] * s, v[1] + amp[1] * s, v[2] + amp[2] * s];
                 let q = *p + cycles * *order;
                 *p = q - libm::floorf(q);
