@@ -81,6 +81,35 @@ fn time(scene: &Scene, truth: &[Truth], min_wall: Duration) -> Result<f64, Strin
     Ok(start.elapsed().as_secs_f64() * 1e9 / n as f64)
 }
 
+/// The sensor model alone, without any chain in front (what an output sample cost before the
+/// chain existed).
+fn time_model_alone(scene: &Scene, truth: &[Truth], min_wall: Duration) -> Result<f64, String> {
+    use margemu_model::sensor::{self, Marg};
+    let f = |v: [f64; 3]| v.map(|x| x as f32);
+    let truth: Vec<sensor::Truth> = truth
+        .iter()
+        .map(|t| sensor::Truth {
+            angular_rate: f(t.body_rate),
+            specific_force: f(t.specific_force),
+            magnetic_field: f(t.field_body),
+            angular_acceleration: f(t.angular_accel),
+            temperature_c: None,
+        })
+        .collect();
+    let config = scene.spec.sensors.config();
+    let start = Instant::now();
+    let mut n = 0u64;
+    while n == 0 || start.elapsed() < min_wall {
+        let mut marg =
+            Marg::new(&config, scene.clock.hz(), scene.spec.seed).map_err(|e| e.to_string())?;
+        for t in &truth {
+            std::hint::black_box(marg.sample(std::hint::black_box(t)));
+        }
+        n += truth.len() as u64;
+    }
+    Ok(start.elapsed().as_secs_f64() * 1e9 / n as f64)
+}
+
 fn rms_difference(a: &[[f32; 6]], b: &[[f32; 6]]) -> [f64; 2] {
     let rms = |axes: std::ops::Range<usize>| {
         let sum: f64 = a
@@ -93,8 +122,9 @@ fn rms_difference(a: &[[f32; 6]], b: &[[f32; 6]]) -> [f64; 2] {
     [rms(0..3), rms(3..6)]
 }
 
-/// The table: per chip, no vibration, and the vibration scene on the output path and on the
-/// internal path; each row timed for at least `min_wall`.
+/// The table: per chip, the sensor model alone, no vibration on either path, and the
+/// vibration scene on the output path and on the internal path; each row timed for at least
+/// `min_wall`.
 pub fn chain_costs(min_wall: Duration) -> Result<Vec<ChainRow>, String> {
     let mut rows = Vec::new();
     for (chip, rate) in CHIPS {
@@ -105,6 +135,13 @@ pub fn chain_costs(min_wall: Duration) -> Result<Vec<ChainRow>, String> {
         let calm_internal = scene(chip, rate, "[vibration]\npath = \"internal\"\n")?;
         let reference = samples(&full, &truth)?;
         let error = rms_difference(&samples(&skipped, &truth)?, &reference);
+        rows.push(ChainRow {
+            chip,
+            rate_hz: rate,
+            case: "the sensor model alone (no chain)",
+            ns_per_sample: time_model_alone(&calm, &truth, min_wall)?,
+            skip_error: None,
+        });
         for (case, s, skip_error) in [
             ("no vibration, output path", &calm, None),
             ("no vibration, internal path", &calm_internal, None),
