@@ -130,8 +130,16 @@ pub fn chain_costs(min_wall: Duration) -> Result<Vec<ChainRow>, String> {
     for (chip, rate) in CHIPS {
         let calm = scene(chip, rate, "")?;
         let truth = collect(&calm).map_err(|e| e.to_string())?;
-        let skipped = scene(chip, rate, &format!("[vibration]\npath = \"output\"\n{VIBRATION}"))?;
-        let full = scene(chip, rate, &format!("[vibration]\npath = \"internal\"\n{VIBRATION}"))?;
+        let skipped = scene(
+            chip,
+            rate,
+            &format!("[vibration]\npath = \"output\"\n{VIBRATION}"),
+        )?;
+        let full = scene(
+            chip,
+            rate,
+            &format!("[vibration]\npath = \"internal\"\n{VIBRATION}"),
+        )?;
         let calm_internal = scene(chip, rate, "[vibration]\npath = \"internal\"\n")?;
         let reference = samples(&full, &truth)?;
         let error = rms_difference(&samples(&skipped, &truth)?, &reference);

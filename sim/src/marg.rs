@@ -11,7 +11,7 @@
 //! the scene's field unit. `perturbation.csv`: `t_ns,mag_x,mag_y,mag_z`, the disturbance added
 //! to the true field per axis (written only when the scene has a `[perturbation]`).
 
-use crate::sampling::HostChain;
+use crate::sampling::HostFront;
 use crate::scene::chip::ChipSetup;
 use crate::scene::vibration::DeviceVibration;
 use crate::scene::Scene;
@@ -50,7 +50,7 @@ pub struct MargSim {
     produced: u64,
     perturbation: Option<HostPerturbation>,
     temperature: Option<[f64; 2]>,
-    chain: Option<HostChain>,
+    chain: Option<HostFront>,
 }
 
 /// Front-end clipping so far: internal samples (or output samples, on the output path) that
@@ -148,17 +148,15 @@ impl MargSim {
 
     /// Front-end clipping so far (`None` for a device without accelerometer and gyroscope).
     pub fn clips(&self) -> Option<ClipCounts> {
-        self.chain.as_ref().map(|c| ClipCounts {
-            accel: c.accel.clips(),
-            gyro: c.gyro.clips(),
+        self.chain.as_ref().map(|c| {
+            let [accel, gyro] = c.clips();
+            ClipCounts { accel, gyro }
         })
     }
 
     /// Whether the device's chain runs at the chip's internal rate.
     pub fn runs_internal_path(&self) -> bool {
-        self.chain
-            .as_ref()
-            .is_some_and(|c| c.accel.period_ns() != 0)
+        self.chain.as_ref().is_some_and(|c| c.runs_internal_path())
     }
 
     /// Whether the scene has a perturbation generator.

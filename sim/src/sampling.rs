@@ -1,9 +1,11 @@
 //! Each device's sampling chain on the host: which path runs ([`SamplingPath`]) and what it is
 //! built from (the chip's declared chain, the vibration reaching the device, its seed).
 //!
-//! - An IMU device always has a chain. On the **output path** (the default when nothing reaching
-//!   the device vibrates above the output Nyquist frequency) it adds the vibration at the output
-//!   instants and clips and counts at the chip's full scale: a few comparisons per sample.
+//! - An IMU device always has a front end. On the **output path** (the default when nothing
+//!   reaching the device vibrates above the output Nyquist frequency) it adds the vibration at
+//!   the output instants and clips and counts at the chip's full scale; without vibration that
+//!   is the [`Clipper`] alone, a few comparisons per sample (what the device runs in source
+//!   mode (b)).
 //! - On the **internal path** it runs the chip's internal rate, front-end clipping, filters and
 //!   decimation ([`margemu_protocol::chip::chain`]): the cost grows with the internal rate.
 //! - A magnetometer-only device has none (vibration does not reach a magnetometer's reading).
@@ -14,7 +16,7 @@
 use crate::scene::chip::ChipSetup;
 use crate::scene::vibration::{DeviceVibration, SamplingPath};
 use crate::scene::Scene;
-use margemu_model::chain::{DeviceChain, SensorPath};
+use margemu_model::chain::{Clipper, DeviceChain, Front, SensorPath};
 use margemu_model::perturbation::Complex;
 use margemu_model::vibration::{RpmPoint, Sense, Vibration};
 use margemu_model::Error;
@@ -22,6 +24,8 @@ use margemu_protocol::chip::chain::{ChipChain, SensorChain};
 
 /// A device's chain with host-owned buffers.
 pub type HostChain = DeviceChain<Vec<RpmPoint>, Vec<Complex>>;
+/// A device's front end with host-owned buffers.
+pub type HostFront = Front<Vec<RpmPoint>, Vec<Complex>>;
 /// One sensor's path with host-owned buffers.
 pub type HostPath = SensorPath<Vec<RpmPoint>, Vec<Complex>>;
 /// One sensor's vibration with host-owned buffers.
@@ -45,41 +49,52 @@ pub fn chip_chain(scene: &Scene, chip: &ChipSetup) -> Option<Result<ChipChain, E
     Some(ChipChain::new(&chip.settings, config, rate).map_err(|_| Error::ChainRefused))
 }
 
-/// The chain of a device mounted as `chip`, with `vibration` reaching it (chip axes) and the
-/// device's seed; `None` for a magnetometer-only device.
+/// The front end of a device mounted as `chip`, with `vibration` reaching it (chip axes) and
+/// the device's seed: the [`Clipper`] when nothing vibrates on the output path, else the
+/// chain; `None` for a magnetometer-only device.
 pub fn build(
     scene: &Scene,
     chip: &ChipSetup,
     vibration: &DeviceVibration,
     seed: u64,
-) -> Option<Result<HostChain, Error>> {
+) -> Option<Result<HostFront, Error>> {
     let [accel_range, gyro_range] = chip.settings.front_end_ranges()?;
-    if !uses_internal_path(scene, vibration) {
+    let internal = uses_internal_path(scene, vibration);
+    if vibration.is_empty() && !internal {
+        return Some(Clipper::new(accel_range, gyro_range).map(Front::Clip));
+    }
+    Some(chain(scene, chip, vibration, seed, internal).map(Front::Chain))
+}
+
+fn chain(
+    scene: &Scene,
+    chip: &ChipSetup,
+    vibration: &DeviceVibration,
+    seed: u64,
+    internal: bool,
+) -> Result<HostChain, Error> {
+    let Some([accel_range, gyro_range]) = chip.settings.front_end_ranges() else {
+        return Err(Error::ChainRefused);
+    };
+    if !internal {
         let period = libm_round(1e9 / scene.clock.hz());
         let path = |sense, range| -> Result<HostPath, Error> {
             SensorPath::at_output(range, sensor_vibration(sense, period, seed, vibration)?)
         };
-        return Some((|| {
-            Ok(DeviceChain {
-                accel: path(Sense::Linear, accel_range)?,
-                gyro: path(Sense::Angular, gyro_range)?,
-            })
-        })());
+        return Ok(DeviceChain {
+            accel: path(Sense::Linear, accel_range)?,
+            gyro: path(Sense::Angular, gyro_range)?,
+        });
     }
-    let declared = match chip_chain(scene, chip)? {
-        Ok(c) => c,
-        Err(e) => return Some(Err(e)),
-    };
+    let declared = chip_chain(scene, chip).ok_or(Error::ChainRefused)??;
     let path = |sense, spec: &SensorChain| -> Result<HostPath, Error> {
         let vib = sensor_vibration(sense, spec.period_ns, seed, vibration)?;
         SensorPath::new(spec.period_ns, spec.filter, spec.range, vib)
     };
-    Some((|| {
-        Ok(DeviceChain {
-            accel: path(Sense::Linear, &declared.accel)?,
-            gyro: path(Sense::Angular, &declared.gyro)?,
-        })
-    })())
+    Ok(DeviceChain {
+        accel: path(Sense::Linear, &declared.accel)?,
+        gyro: path(Sense::Angular, &declared.gyro)?,
+    })
 }
 
 fn libm_round(x: f64) -> u64 {

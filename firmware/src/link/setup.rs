@@ -1,10 +1,8 @@
 //! Applying a [`Configure`]: the chip (model, identity, image length, I2C address), its register
 //! overrides, and the model of source mode (b).
 
-use margemu_model::chain::{DeviceChain, SensorPath};
-use margemu_model::perturbation::Complex;
+use margemu_model::chain::Clipper;
 use margemu_model::sensor::{Marg, Truth};
-use margemu_model::vibration::{RpmPoint, Sense, Vibration};
 use margemu_protocol::chip::PhysicalSample;
 use margemu_protocol::link::{Chips, Configure, ErrorCode, Image, ModelParams, Rate, Source};
 
@@ -35,12 +33,12 @@ pub fn build_chip(cfg: &Configure) -> Result<EmulatedChip, ErrorCode> {
     Ok(chip)
 }
 
-/// The sensor model of source mode (b) at the output rate: the front end on the output path
-/// (clipping at the chip's full scale, counted; no vibration) and the error terms. The host's
-/// model of a device without vibration is the same ([`DeviceModel::new`] on both sides).
+/// The sensor model of source mode (b) at the output rate: the front end of the output path
+/// without vibration (a [`Clipper`]: clipping at the chip's full scale, counted) and the error
+/// terms. The host's model of a device without vibration is the same.
 pub struct DeviceModel {
     marg: Marg,
-    front: Option<DeviceChain<[RpmPoint; 0], [Complex; 0]>>,
+    front: Option<Clipper>,
 }
 
 impl DeviceModel {
@@ -55,14 +53,7 @@ impl DeviceModel {
         let marg = Marg::new(cfg, rate_hz, seed)?;
         let front = match chip.settings().front_end_ranges() {
             None => None,
-            Some([accel, gyro]) => {
-                let path =
-                    |sense, range| SensorPath::at_output(range, Vibration::new(sense, 1, seed));
-                Some(DeviceChain {
-                    accel: path(Sense::Linear, accel)?,
-                    gyro: path(Sense::Angular, gyro)?,
-                })
-            }
+            Some([accel, gyro]) => Some(Clipper::new(accel, gyro)?),
         };
         Ok(Self { marg, front })
     }
@@ -70,17 +61,16 @@ impl DeviceModel {
     /// One output sample at `t_ns` from `truth`.
     #[inline]
     pub fn sample(&mut self, t_ns: u64, truth: &Truth) -> margemu_model::sensor::Sample {
+        let _ = t_ns;
         match self.front.as_mut() {
-            Some(front) => front.sample(&mut self.marg, t_ns, truth),
+            Some(front) => front.sample(&mut self.marg, truth),
             None => self.marg.sample(truth),
         }
     }
 
     /// Front-end clipping so far, `[accel, gyro]` per axis (zeros without a front end).
     pub fn clips(&self) -> [[u64; 3]; 2] {
-        self.front
-            .as_ref()
-            .map_or([[0; 3]; 2], |f| [f.accel.clips(), f.gyro.clips()])
+        self.front.as_ref().map_or([[0; 3]; 2], Clipper::clips)
     }
 }
 

@@ -187,3 +187,91 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> DeviceChain<P
         marg.sample_chained(truth, a, w)
     }
 }
+
+/// The output path's front end when nothing vibrates: each axis of the specific force and the
+/// body rate clipped at the chip's full scale and counted, nothing else (a NaN passes as NaN,
+/// for that sample only, as through the sensor model). A few bytes, where a [`DeviceChain`]
+/// holds vibration sources and filter states: what a device runs in source mode (b).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clipper {
+    ranges: [f32; 2],
+    clips: [[u64; 3]; 2],
+}
+
+impl Clipper {
+    /// Clipping at `±accel` m/s² and `±gyro` rad/s (each > 0).
+    pub fn new(accel: f32, gyro: f32) -> Result<Self, Error> {
+        if [accel, gyro].iter().any(|r| r.is_nan() || *r <= 0.0) {
+            return Err(Error::NonPositiveParameter {
+                what: "chain.range",
+            });
+        }
+        Ok(Self {
+            ranges: [accel, gyro],
+            clips: [[0; 3]; 2],
+        })
+    }
+
+    fn clip(v: Vec3, range: f32, clips: &mut [u64; 3]) -> Vec3 {
+        let mut out = v;
+        for ((x, c), o) in v.iter().zip(clips.iter_mut()).zip(out.iter_mut()) {
+            if *x > range {
+                *c += 1;
+                *o = range;
+            } else if *x < -range {
+                *c += 1;
+                *o = -range;
+            }
+        }
+        out
+    }
+
+    /// One output sample of `marg` behind the clipper, from `truth`.
+    #[inline]
+    pub fn sample(&mut self, marg: &mut Marg, truth: &Truth) -> Sample {
+        let [accel, gyro] = &mut self.clips;
+        let f = marg.accel().specific_force_at_sensor(truth);
+        let a = Self::clip(f, self.ranges[0], accel);
+        let w = Self::clip(clamp(truth.angular_rate, INPUT_LIMIT), self.ranges[1], gyro);
+        marg.sample_chained(truth, a, w)
+    }
+
+    /// Samples clipped so far, `[accel, gyro]` per axis.
+    pub fn clips(&self) -> [[u64; 3]; 2] {
+        self.clips
+    }
+}
+
+/// What stands in front of a device's sensor model: the [`Clipper`] when nothing vibrates on
+/// the output path, else a [`DeviceChain`].
+pub enum Front<P, B> {
+    /// Clipping only.
+    Clip(Clipper),
+    /// Vibration, and the internal path's filters.
+    Chain(DeviceChain<P, B>),
+}
+
+impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> Front<P, B> {
+    /// One output sample at `t_ns` of `marg` behind this front end, from `truth`.
+    #[inline]
+    pub fn sample(&mut self, marg: &mut Marg, t_ns: u64, truth: &Truth) -> Sample {
+        match self {
+            Front::Clip(c) => c.sample(marg, truth),
+            Front::Chain(c) => c.sample(marg, t_ns, truth),
+        }
+    }
+
+    /// Samples (internal samples on the internal path) clipped so far, `[accel, gyro]` per
+    /// axis.
+    pub fn clips(&self) -> [[u64; 3]; 2] {
+        match self {
+            Front::Clip(c) => c.clips(),
+            Front::Chain(c) => [c.accel.clips(), c.gyro.clips()],
+        }
+    }
+
+    /// Whether the chain runs at the chip's internal rate.
+    pub fn runs_internal_path(&self) -> bool {
+        matches!(self, Front::Chain(c) if c.accel.period_ns() != 0)
+    }
+}
