@@ -84,23 +84,24 @@ impl MargSample {
 }
 
 impl MargSim {
-    /// The model of `scene` (already validated, so this fails only on a model it refused).
+    /// The model of `scene` (already validated, so this fails only on a model it refused), in
+    /// plate axes: what `simulate` writes and the offline filters read. Without vibration it
+    /// is eq. 18 alone (no chip front end: the scene's `[sensors.*] range` clips, if given);
+    /// with vibration or `path = "internal"`, device 0's chain runs in front of it.
     pub fn new(scene: &Scene) -> Result<Self, margemu_model::Error> {
         let vibration = scene.vibration.first().cloned().unwrap_or_default();
         let vibration = crate::sampling::in_plate_axes(&vibration, &scene.chip);
-        Self::build(
-            scene,
-            &scene.spec.sensors.config(),
-            scene.spec.seed,
-            (&scene.chip, &vibration),
-        )
+        let chip = (!vibration.is_empty() || crate::sampling::forces_internal_path(scene))
+            .then_some((&scene.chip, &vibration));
+        Self::build(scene, &scene.spec.sensors.config(), scene.spec.seed, chip)
     }
 
     /// The model of device `index` of `scene`'s rig ([`Scene::devices`]): the scene's sensor
     /// terms on the device's own seed ([`device_seed`]), its lever arm
     /// ([`ChipSetup::offset`](crate::scene::chip::ChipSetup::offset), turned into the chip's
-    /// axes) added to `[sensors.accel] lever_arm`. Device 0 is [`MargSim::new`]'s model when it
-    /// has no offset. `None` if the scene has no such device.
+    /// axes) added to `[sensors.accel] lever_arm`, behind the chip's front end (clipping at its
+    /// full scale, counted; its sampling chain with vibration: [`crate::sampling`]), as the
+    /// chip serves it. `None` if the scene has no such device.
     pub fn for_device(scene: &Scene, index: usize) -> Option<Result<Self, margemu_model::Error>> {
         let device = scene.devices().into_iter().nth(index)?;
         let mut config = scene.spec.sensors.config();
@@ -114,7 +115,7 @@ impl MargSim {
             scene,
             &config,
             device_seed(scene.spec.seed, index),
-            (&device.chip, &vibration),
+            Some((&device.chip, &vibration)),
         ))
     }
 
@@ -122,9 +123,11 @@ impl MargSim {
         scene: &Scene,
         config: &sensor::MargConfig,
         seed: u64,
-        (chip, vibration): (&ChipSetup, &DeviceVibration),
+        front: Option<(&ChipSetup, &DeviceVibration)>,
     ) -> Result<Self, margemu_model::Error> {
-        let chain = crate::sampling::build(scene, chip, vibration, seed).transpose()?;
+        let chain = front
+            .and_then(|(chip, vibration)| crate::sampling::build(scene, chip, vibration, seed))
+            .transpose()?;
         let spec = &scene.spec;
         let rate = scene.clock.hz();
         let marg = Marg::new(config, rate, seed)?;

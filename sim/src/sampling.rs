@@ -40,6 +40,11 @@ pub fn uses_internal_path(scene: &Scene, vibration: &DeviceVibration) -> bool {
     }
 }
 
+/// Whether the scene asks for the internal path whatever vibrates (`path = "internal"`).
+pub fn forces_internal_path(scene: &Scene) -> bool {
+    scene.sampling == SamplingPath::Internal
+}
+
 /// The chip's declared chain at the scene's output rate (`None` for a magnetometer).
 pub fn chip_chain(scene: &Scene, chip: &ChipSetup) -> Option<Result<ChipChain, Error>> {
     let config = chip.chain.as_ref()?;
