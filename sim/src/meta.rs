@@ -184,6 +184,13 @@ pub struct ChipMeta {
     /// The lever arm, m, plate axes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub offset: Option<[f64; 3]>,
+    /// The filter settings its sampling chain runs with: `[chip.filters]` over the family's
+    /// defaults, every key of the family (absent for a magnetometer).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filters: Option<std::collections::BTreeMap<String, u8>>,
+    /// Where its chain runs: `output` or `internal` (absent for a magnetometer).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling_path: Option<String>,
 }
 
 /// `[image]` of a session: the InvenSense 6xxx family's conversion settings (offsets, AK8963),

@@ -4,6 +4,7 @@
 
 use super::images::ImageSettings;
 use super::session::StreamConfig;
+use margemu_protocol::chip::chain::ChainConfig;
 use margemu_protocol::chip::{ChipSettings, Conversion};
 use margemu_protocol::link::{HelloAck, Rate};
 use margemu_protocol::PROTOCOL_VERSION;
@@ -44,14 +45,15 @@ pub(super) fn metadata(
         default_temp_c: s.default_temp_c,
         chip: ChipMeta {
             name: Some(scene.chip_name.clone()),
-            ..chip_meta(&scene.chip, &s.chip)
+            ..chip_meta(&scene.chip, &s.chip, internal_path(scene, 0))
         },
         other_devices: scene
             .other_devices
             .iter()
-            .map(|d| ChipMeta {
+            .enumerate()
+            .map(|(i, d)| ChipMeta {
                 name: Some(d.name.clone()),
-                ..chip_meta(&d.chip, &d.chip.settings)
+                ..chip_meta(&d.chip, &d.chip.settings, internal_path(scene, i + 1))
             })
             .collect(),
         image: match &s.chip.conversion {
@@ -78,9 +80,19 @@ pub(super) fn metadata(
     }
 }
 
-/// `chip`'s table, its images computed with `settings`.
-fn chip_meta(chip: &ChipSetup, settings: &ChipSettings) -> ChipMeta {
+/// Whether device `index`'s sampling chain runs at its internal rate.
+fn internal_path(scene: &Scene, index: usize) -> bool {
+    let vibration = scene.vibration.get(index).cloned().unwrap_or_default();
+    margemu_sim::sampling::uses_internal_path(scene, &vibration)
+}
+
+/// `chip`'s table, its images computed with `settings`, its chain on the internal path or not.
+fn chip_meta(chip: &ChipSetup, settings: &ChipSettings, internal: bool) -> ChipMeta {
     let fs = settings.full_scale();
+    let filters = chip.chain.map(|c| {
+        let keys = ChainConfig::keys(c.family());
+        keys.iter().map(|k| k.to_string()).zip(c.values()).collect()
+    });
     ChipMeta {
         model: settings.model.name().to_string(),
         who_am_i: chip.who_am_i,
@@ -94,6 +106,10 @@ fn chip_meta(chip: &ChipSetup, settings: &ChipSettings) -> ChipMeta {
         name: None,
         chip_select: (chip.bus == BusKind::Spi).then_some(chip.chip_select),
         offset: chip.offset,
+        sampling_path: filters
+            .as_ref()
+            .map(|_| if internal { "internal" } else { "output" }.to_string()),
+        filters,
     }
 }
 

@@ -105,8 +105,8 @@ impl Cmd {
             Cmd::Chain { seconds } => {
                 println!(
                     "host cost per output sample of the sensor model behind each chip's sampling \
-                     chain (1 s static scenes, white noise; vibration: {})\n",
-                    "4 motors 9000→15000 rpm × 2 harmonics, a PSD 20–2000 Hz, one 11 ms shock"
+                     chain (1 s static scenes, white noise; vibration: 4 motors 9000→15000 rpm × \
+                     2 harmonics, a PSD 20–2000 Hz, one 11 ms shock)\n"
                 );
                 println!(
                     "| chip | rate (Hz) | case | ns per sample | error of skipping: accel RMS (m/s²) | gyro RMS (rad/s) |"

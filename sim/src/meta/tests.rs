@@ -61,6 +61,8 @@ fn session() -> SessionMeta {
             name: Some("imu".into()),
             chip_select: Some(0),
             offset: None,
+            filters: Some([("gyro_aaf_delt".to_string(), 6u8)].into_iter().collect()),
+            sampling_path: Some("internal".into()),
         },
         other_devices: vec![ChipMeta {
             model: "ist8310".into(),
@@ -75,6 +77,8 @@ fn session() -> SessionMeta {
             name: Some("compass".into()),
             chip_select: None,
             offset: Some([0.0, 0.0, 0.03]),
+            filters: None,
+            sampling_path: None,
         }],
         image: None,
         scene_text: run.scene_text,

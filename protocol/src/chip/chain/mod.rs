@@ -49,7 +49,8 @@
 //! let rate = Rate::hz(1000).unwrap();
 //! let config = ChainConfig::default_for(model, rate).unwrap(); // DLPF_CFG 1: 184 Hz
 //! let chain = ChipChain::new(&ChipSettings::power_on(model), &config, rate)?;
-//! assert_eq!((chain.gyro.period_ns, chain.output_period_ns), (1_000_000, 1_000_000));
+//! // The DLPF runs on the 8 kHz ADC samples; the registers update at 1 kHz.
+//! assert_eq!((chain.gyro.period_ns, chain.output_period_ns), (125_000, 1_000_000));
 //! assert_eq!(chain.gyro.bandwidth_hz, 184.0);
 //! assert!((chain.gyro.filter.gain_at(184.0) - 0.7071).abs() < 1e-3);
 //! assert!((chain.gyro.filter.delay_s() - 2.9e-3).abs() <= 0.5e-3);
