@@ -244,6 +244,7 @@ impl Clipper {
 
 /// What stands in front of a device's sensor model: the [`Clipper`] when nothing vibrates on
 /// the output path, else a [`DeviceChain`].
+#[allow(clippy::large_enum_variant)] // no alloc here to box with; one per device
 pub enum Front<P, B> {
     /// Clipping only.
     Clip(Clipper),
