@@ -47,9 +47,11 @@ use super::predictor::{run_scene, Predictions};
 use super::session::rate_of;
 use super::StreamError;
 use margemu_firmware::chip::{Chip, EmulatedChip};
-use margemu_firmware::link::setup::{self, DeviceModel};
+use margemu_firmware::link::setup::{self, ChainSetup, DeviceModel, ModelChain};
 use margemu_model::sensor;
-use margemu_protocol::link::{Image, ModelParams, Rate};
+use margemu_model::vibration::{Sense, ToneSource, MAX_SHOCKS, MAX_TONE_SOURCES};
+use margemu_protocol::link::{AddVibration, Image, ModelParams, Rate, RpmProfile, MAX_RPM_POINTS};
+use margemu_sim::sampling::uses_internal_path;
 use margemu_sim::scene::chip::ChipSetup;
 use margemu_sim::scene::Scene;
 use margemu_sim::truth::Truth;
@@ -64,6 +66,9 @@ pub struct ModelPrediction {
     pub hold: u32,
     /// What Configure carries: seed, kinematics rate, µT per unit, the model terms.
     pub params: ModelParams,
+    /// The AddVibration messages that follow Configure: the chain's path, each tone source,
+    /// each shock ([`model_chain_setup`]).
+    pub vibration: Vec<AddVibration>,
     /// Every output sample in order: its truth, the image the device will serve, and the
     /// kinematics sample due at its instant (every `hold`-th sample's, from sample 0).
     pub samples: Predictions<ModelSample>,
@@ -101,10 +106,8 @@ pub fn predict_model(
                 .into(),
         });
     }
-    if let Some(reason) = vibration_refusal(scene) {
-        return Err(StreamError::Model { reason });
-    }
     let rate = rate_of(scene)?;
+    let chain = model_chain_setup(scene, rate).map_err(|reason| StreamError::Model { reason })?;
     let chip = device_chip(&scene.chip, rate)?;
     if settings.chip != chip.settings() {
         return Err(StreamError::Model {
@@ -120,8 +123,9 @@ pub fn predict_model(
         ..ModelParams::new(scene.spec.seed, truth_rate, scene.spec.sensors.config())
     };
     let scene = scene.clone();
+    let vibration = chain.messages().collect();
     let samples = Predictions::spawn(move |emit| {
-        let mut model = DeviceModel::new(&params.marg, rate.as_hz_f64(), params.seed, &chip)
+        let mut model = DeviceModel::new(&params.marg, rate, params.seed, &chip, &chain)
             .map_err(margemu_sim::run::RunError::Model)?;
         let temperature = scene.spec.sensors.temperature;
         let (mut k, mut held) = (0u64, None);
@@ -150,31 +154,156 @@ pub fn predict_model(
     Ok(ModelPrediction {
         hold,
         params,
+        vibration,
         samples,
     })
 }
 
-/// Why source mode (b) cannot run `scene`'s sampling chain, if it cannot: vibration, or the
-/// chip's internal-rate path asked for. The device's model runs at the output rate from held
-/// kinematics; the vibration sources and the internal-rate filters are not carried by the link.
+/// Why source mode (b) cannot run `scene`'s sampling chain, if it cannot
+/// ([`model_chain_setup`]'s refusal).
 pub fn vibration_refusal(scene: &Scene) -> Option<String> {
-    let vibrates = scene.vibration.iter().any(|v| !v.is_empty());
-    let internal = scene.sampling == margemu_sim::scene::vibration::SamplingPath::Internal;
-    (vibrates || internal).then(|| {
-        format!(
-            "the scene has {}: source mode (b) runs the sensor model on the device at the \
-             output rate from held kinematics, without vibration or the chip's internal-rate \
-             filters (the chain costs the Cortex-M4F {}; see the guide's sampling-chain \
-             figures); stream it as register images (source images), where the host runs the \
-             chain",
-            if vibrates {
-                "[vibration]"
-            } else {
-                "[vibration] path = \"internal\""
-            },
-            "thousands of instructions per output sample at 8 kHz"
-        )
-    })
+    let rate = rate_of(scene).ok()?;
+    model_chain_setup(scene, rate).err()
+}
+
+/// Instructions per output sample of the sensor model and the bookkeeping of an output-path
+/// chain without vibration, on the Cortex-M4F (`docs/figures.md`, "Sampling chain on the
+/// Cortex-M4F": 1 459 on the output path, 1 666 on the ICM-20602's internal path, 4 931 on the
+/// ICM-42688-P's, fitted with the costs below).
+pub const COST_BASE: f64 = 1000.0;
+/// Instructions per sensor and step of the output path (2 × 230 + 1 000 ≈ 1 459).
+pub const COST_OUTPUT_STEP: f64 = 230.0;
+/// Instructions per sensor and internal sample of the internal path, filters and clipping
+/// ((4 931 − 1 666) / (8 + 8 − 1 − 0.5) ≈ 500 per step).
+pub const COST_FILTER_STEP: f64 = 500.0;
+/// Instructions per tone (source × motor × harmonic) or shock, per sensor sample: the f32 sine
+/// of the phase in cycles (output path with 4 motors × 2 harmonics on both sensors at 8 kHz:
+/// ≈ 3 900; the ICM-42688-P's internal path with them and a shock: ≈ 14 500).
+pub const COST_TONE: f64 = 150.0;
+/// Instructions per second of a 96 MHz Cortex-M4F at 1.25 cycles per instruction, doing
+/// nothing else.
+pub const M4F_INSTRUCTIONS_PER_S: f64 = 96e6 / 1.25;
+
+/// What source mode (b)'s chain is on the device for `scene` at `rate` (device 0's vibration in
+/// the chip's axes, the path `margemu_sim::sampling::uses_internal_path` picks, the chip's
+/// declared filters), or why the device cannot run it, before anything is sent:
+///
+/// - random vibration (its synthesis needs FFT buffers the device does not have);
+/// - a tone source of more than [`MAX_RPM_POINTS`] rpm points, more than
+///   [`MAX_TONE_SOURCES`] tone sources or [`MAX_SHOCKS`] shocks;
+/// - a chain the model refuses;
+/// - a chain too slow for a 96 MHz Cortex-M4F at the scene's rate: [`chain_cost`] instructions
+///   per output sample above [`M4F_INSTRUCTIONS_PER_S`] / rate.
+pub fn model_chain_setup(scene: &Scene, rate: Rate) -> Result<ChainSetup, String> {
+    let advice = "stream it as register images (source images), where the host runs the chain";
+    let vibration = scene.vibration.first().cloned().unwrap_or_default();
+    if vibration.random.is_some() {
+        return Err(format!(
+            "the scene has random vibration ([[vibration.random]]): its synthesis needs FFT \
+             buffers (tens of KB) the device does not have; {advice}"
+        ));
+    }
+    let mut setup = ChainSetup {
+        internal: match uses_internal_path(scene, &vibration) {
+            true => scene.chip.chain,
+            false => None,
+        },
+        ..ChainSetup::default()
+    };
+    for (i, t) in vibration.tones.iter().enumerate() {
+        let profile = RpmProfile::from_slice(&t.profile).map_err(|_| {
+            format!(
+                "tone source {} has {} rpm points: the device holds at most {MAX_RPM_POINTS} per \
+                 source; {advice}",
+                i + 1,
+                t.profile.len()
+            )
+        })?;
+        let mut tones = ToneSource::new(t.motors, profile);
+        tones.spread = t.spread;
+        for h in t.harmonics() {
+            tones.push(*h).map_err(|e| e.to_string())?;
+        }
+        setup.tones.push(tones).map_err(|_| {
+            format!(
+                "the scene has {} tone sources: the device holds at most {MAX_TONE_SOURCES}; \
+                 {advice}",
+                vibration.tones.len()
+            )
+        })?;
+    }
+    for shock in &vibration.shocks {
+        setup.shocks.push(*shock).map_err(|_| {
+            format!(
+                "the scene has {} shocks: the device holds at most {MAX_SHOCKS}; {advice}",
+                vibration.shocks.len()
+            )
+        })?;
+    }
+    let chain = setup::model_chain(&scene.chip.settings, rate, scene.spec.seed, &setup);
+    if let Some(chain) = chain {
+        let chain = chain.map_err(|e| format!("the device's model refuses the chain: {e}"))?;
+        let cost = chain_cost(&setup, &chain, rate);
+        let hz = rate.as_hz_f64();
+        let share = cost * hz / M4F_INSTRUCTIONS_PER_S;
+        if share > 1.0 {
+            return Err(format!(
+                "the chain needs ≈ {} instructions per output sample, {:.0} % of a 96 MHz \
+                 Cortex-M4F at {hz} Hz (cost model: {COST_BASE} + per sensor sample \
+                 {COST_FILTER_STEP} on the internal path or {COST_OUTPUT_STEP} on the output \
+                 path + {COST_TONE} per tone (source × motor × harmonic) or shock and sensor \
+                 sample; 1.25 cycles per instruction); {advice}",
+                grouped(cost.round() as u64),
+                share * 100.0
+            ));
+        }
+    }
+    Ok(setup)
+}
+
+/// Instructions per output sample of `chain` (built from `setup`) on the Cortex-M4F at `rate`
+/// (the cost model of [`COST_BASE`], [`COST_OUTPUT_STEP`], [`COST_FILTER_STEP`],
+/// [`COST_TONE`]): per sensor, its samples per output sample times its step's cost and its
+/// tones and shocks.
+pub fn chain_cost(setup: &ChainSetup, chain: &ModelChain, rate: Rate) -> f64 {
+    let out_ns = 1e9 / rate.as_hz_f64();
+    let sensor = |sense: Sense, period_ns: u64| {
+        let (samples, step) = match period_ns {
+            0 => (1.0, COST_OUTPUT_STEP),
+            p => (out_ns / p as f64, COST_FILTER_STEP),
+        };
+        let tones: usize = setup
+            .tones
+            .iter()
+            .filter(|t| t.moves(sense))
+            .map(|t| usize::from(t.motors) * t.harmonics().len())
+            .sum();
+        let shocks = setup
+            .shocks
+            .iter()
+            .filter(|s| match sense {
+                Sense::Linear => s.linear != [0.0; 3],
+                Sense::Angular => s.angular != [0.0; 3],
+            })
+            .count();
+        samples * (step + COST_TONE * (tones + shocks) as f64)
+    };
+    COST_BASE
+        + sensor(Sense::Linear, chain.accel.period_ns())
+        + sensor(Sense::Angular, chain.gyro.period_ns())
+}
+
+/// `n` with its thousands apart: `14 500`.
+fn grouped(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
 }
 
 /// The chip a device builds from the Configure of `chip` at `rate`: what it converts with.
@@ -188,16 +317,18 @@ pub fn device_chip(chip: &ChipSetup, rate: Rate) -> Result<EmulatedChip, StreamE
 }
 
 /// The images the device serves at output samples `0 .. samples` in source mode (b), from
-/// `kinematics` held for `hold` output samples each, converted by `chip` (see the module docs).
+/// `kinematics` held for `hold` output samples each, behind the chain `chain` builds, converted
+/// by `chip` (see the module docs).
 pub fn model_images(
     params: &ModelParams,
     rate: Rate,
+    chain: &ChainSetup,
     hold: u32,
     kinematics: &[sensor::Truth],
     samples: usize,
     chip: &impl Chip,
 ) -> Result<Vec<Image>, StreamError> {
-    let mut model = DeviceModel::new(&params.marg, rate.as_hz_f64(), params.seed, chip)
+    let mut model = DeviceModel::new(&params.marg, rate, params.seed, chip, chain)
         .map_err(margemu_sim::run::RunError::Model)?;
     let held = (0..samples).filter_map(|k| {
         let t = kinematics.get(k / hold.max(1) as usize)?;
