@@ -298,7 +298,7 @@ fn grouped(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
             out.push(' ');
         }
         out.push(c);
@@ -428,6 +428,73 @@ mod tests {
                 "{model:?} at its largest ranges"
             );
         }
+    }
+
+    #[test]
+    fn the_prediction_runs_the_scenes_chain_and_sends_it() {
+        let base = "duration = 0.1\nrate = 1000.0\nseed = 3\nmotion = \"static\"\n\
+                    [chip]\nmodel = \"icm20602\"\n";
+        let tone = "[[vibration.tones]]\nmotors = 2\nrpm = 6000\n\
+                    [[vibration.tones.harmonics]]\norder = 1.0\nlinear = [0.0, 0.0, 5.0]\n\
+                    [[vibration.shocks]]\nat = 0.05\nduration = 0.01\nangular = [1.0, 0.0, 0.0]\n";
+        let images = |text: &str| {
+            let scene = Scene::parse_str(text, std::path::Path::new("s.toml")).unwrap();
+            let p = predict_model(&scene, &ImageSettings::for_scene(&scene), None).unwrap();
+            let images: Vec<Image> = p.samples.map(|s| s.unwrap().sample.image).collect();
+            (p.vibration, images)
+        };
+        let (quiet_msgs, quiet) = images(base);
+        assert_eq!(quiet_msgs, [AddVibration::Path(None)]);
+        let (msgs, shaken) = images(&format!("{base}{tone}"));
+        assert!(matches!(
+            msgs.as_slice(),
+            [AddVibration::Path(None), AddVibration::Tones(t), AddVibration::Shock(_)]
+                if t.motors == 2 && t.profile.len() == 1
+        ));
+        let differ = quiet.iter().zip(&shaken).filter(|(a, b)| a != b).count();
+        assert!(differ > 90, "{differ} of 100 images differ");
+        let (msgs, _) = images(&format!("{base}[vibration]\npath = \"internal\"\n{tone}"));
+        assert!(matches!(msgs.first(), Some(AddVibration::Path(Some(_)))));
+    }
+
+    #[test]
+    fn the_cost_model_matches_the_measured_cases() {
+        // The measured cases: 4 motors × 2 harmonics on both sensors and a shock, 8 kHz.
+        let base = "duration = 0.01\nrate = 8000.0\nseed = 3\nmotion = \"static\"\n";
+        let tones = "[[vibration.tones]]\nmotors = 4\nrpm = 6000\n\
+                     [[vibration.tones.harmonics]]\norder = 1.0\nlinear = [0.0, 0.0, 1.0]\n\
+                     angular = [0.1, 0.0, 0.0]\n\
+                     [[vibration.tones.harmonics]]\norder = 2.0\nlinear = [1.0, 0.0, 0.0]\n\
+                     angular = [0.1, 0.0, 0.0]\n";
+        let cost = |chip: &str, path: &str, extra: &str| {
+            let text = format!(
+                "{base}[chip]\nmodel = \"{chip}\"\n[vibration]\npath = \"{path}\"\n{extra}"
+            );
+            let scene = Scene::parse_str(&text, std::path::Path::new("s.toml")).unwrap();
+            let rate = rate_of(&scene).unwrap();
+            let mut setup = ChainSetup {
+                internal: (path == "internal").then_some(scene.chip.chain).flatten(),
+                ..ChainSetup::default()
+            };
+            for t in &scene.vibration[0].tones {
+                let mut tones =
+                    ToneSource::new(t.motors, RpmProfile::from_slice(&t.profile).unwrap());
+                t.harmonics().iter().for_each(|h| tones.push(*h).unwrap());
+                setup.tones.push(tones).unwrap();
+            }
+            let chain = setup::model_chain(&scene.chip.settings, rate, 3, &setup);
+            chain_cost(&setup, &chain.unwrap().unwrap(), rate)
+        };
+        // Measured: 1 459, 1 666, 4 931 quiet; ≈ 3 500–4 000 with tones at 8 kHz; ≈ 14 500 on
+        // the ICM-42688-P's internal path with tones.
+        assert_eq!(cost("icm20602", "output", ""), 1460.0);
+        assert_eq!(cost("icm20602", "internal", ""), 1750.0);
+        assert_eq!(cost("icm42688p", "internal", ""), 5000.0);
+        assert_eq!(cost("icm20602", "output", tones), 3860.0);
+        assert_eq!(cost("icm20602", "internal", tones), 3550.0);
+        assert_eq!(cost("icm42688p", "internal", tones), 14600.0);
+        assert_eq!(grouped(14600), "14 600");
+        assert_eq!(grouped(999), "999");
     }
 
     #[test]

@@ -36,6 +36,7 @@ pub type RpmProfile = heapless::Vec<RpmPoint, MAX_RPM_POINTS>;
 
 /// Host → device: one piece of the source-(b) sampling chain.
 #[derive(Clone, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)] // no alloc: a tone source is held by value, one at a time
 pub enum AddVibration {
     /// Which path the chain runs: `Some` settings for the chip's internal path, `None` for the
     /// output path.
