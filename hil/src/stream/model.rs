@@ -12,8 +12,8 @@
 //!   none);
 //! - **the device** (`margemu_firmware::link`, `docs/spec/link.md` §5.3.1) serves output
 //!   sample `k` from the latest kinematics at or before `t_k`, i.e. `j = k / hold` (zero-order
-//!   hold), steps its model ([`Marg`] with the scene's terms and seed at `rate.as_hz_f64()`)
-//!   once per output instant, scales the field to µT as `(f64::from(mag) * mag_ut_per_unit) as
+//!   hold), steps its model ([`Marg`](margemu_model::sensor::Marg) with the scene's terms and
+//!   seed at `rate.as_hz_f64()`, behind the scene's sampling chain) once per output instant, scales the field to µT as `(f64::from(mag) * mag_ut_per_unit) as
 //!   f32`, takes the die temperature of the kinematics (21 °C without one) and converts with
 //!   the settings of the chip the scene's Configure builds (the firmware's own
 //!   `setup::build_chip` and `setup::model_image`, so host and device share every step).
@@ -22,10 +22,17 @@
 //! say). The prediction holds while the device under test leaves the full-scale and offset
 //! registers where Configure put them (the device converts with the chip's current settings).
 //!
+//! **The sampling chain.** The device's model runs behind the scene's chain
+//! ([`model_chain_setup`]: device 0's tones and shocks in the chip's axes, on the path the host
+//! would take), which the session sends after Configure as AddVibration messages
+//! ([`ModelPrediction::vibration`]); host and device build it with the one constructor
+//! `setup::model_chain`, so the images stay bit-identical.
+//!
 //! Scenes the device cannot run are refused before anything is sent ([`StreamError::Model`]):
-//! a magnetic perturbation (its generator's FFT buffers do not fit a no-alloc device), image
-//! settings other than those of the configured chip, and a kinematics rate that does not divide
-//! the output rate.
+//! a magnetic perturbation or random vibration (their FFT buffers do not fit a no-alloc
+//! device), more rpm points, tone sources or shocks than the device holds, a chain too slow for
+//! a 96 MHz Cortex-M4F at the scene's rate ([`chain_cost`]), image settings other than those of
+//! the configured chip, and a kinematics rate that does not divide the output rate.
 //!
 //! ```
 //! use margemu_sim::scene::Scene;
@@ -177,8 +184,9 @@ pub const COST_OUTPUT_STEP: f64 = 230.0;
 /// ((4 931 − 1 666) / (8 + 8 − 1 − 0.5) ≈ 500 per step).
 pub const COST_FILTER_STEP: f64 = 500.0;
 /// Instructions per tone (source × motor × harmonic) or shock, per sensor sample: the f32 sine
-/// of the phase in cycles (output path with 4 motors × 2 harmonics on both sensors at 8 kHz:
-/// ≈ 3 900; the ICM-42688-P's internal path with them and a shock: ≈ 14 500).
+/// of the phase in cycles, as measured on the M4F since tones use it (output path with
+/// 4 motors × 2 harmonics on both sensors at 8 kHz: 3 500–4 000; the ICM-42688-P's internal
+/// path with them and a shock: ≈ 14 500; the figures table's tone rows predate that sine).
 pub const COST_TONE: f64 = 150.0;
 /// Instructions per second of a 96 MHz Cortex-M4F at 1.25 cycles per instruction, doing
 /// nothing else.
