@@ -1,7 +1,8 @@
 //! Vibration end to end: a random PSD recovered from `marg.csv` with `analyze`'s Welch
 //! estimate, a session's `clipping.csv` with the counters the host's chain kept, the
-//! internal-rate path served byte for byte over the loopback, and source mode model refusing a
-//! vibration scene before sending anything.
+//! internal-rate path served byte for byte over the loopback, and source mode model running
+//! tones and shocks on the device byte for byte, or refusing (random vibration, too many rpm
+//! points, a chain too slow for the Cortex-M4F) before sending anything.
 
 mod common;
 
@@ -150,12 +151,11 @@ fn a_session_logs_the_clipping_counters_and_serves_the_chain_byte_for_byte() {
     assert!(counts.windows(2).all(|w| w[0] <= w[1]) && rows.len() > 100);
 }
 
-#[test]
-fn source_model_refuses_a_vibration_scene_before_sending_anything() {
-    let dir = common::scratch("vibration-model");
+/// `margemu loopback --source model` of `text` into a fresh `name` directory: the session
+/// directory, stdout and stderr, and whether it succeeded.
+fn loopback_model(text: &str, name: &str) -> (std::path::PathBuf, String, String, bool) {
+    let dir = common::scratch(name);
     std::fs::create_dir_all(&dir).unwrap();
-    let text = random_scene("[[40.0, 0.002], [1500.0, 0.008]]", "")
-        .replace("duration = 8.0", "duration = 0.5");
     std::fs::write(dir.join("scene.toml"), text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
         .args(["loopback", "--source", "model", "-o"])
@@ -163,11 +163,86 @@ fn source_model_refuses_a_vibration_scene_before_sending_anything() {
         .arg(dir.join("scene.toml"))
         .output()
         .unwrap();
-    assert!(!out.status.success());
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        stderr.contains("source mode model cannot run this scene: the scene has [vibration]"),
-        "{stderr}"
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    (dir.join("session"), stdout, stderr, out.status.success())
+}
+
+/// Four motors on an rpm ramp (two harmonics, linear and angular) and a shock, on `chip` at
+/// `rate` for 0.5 s, on `path`.
+fn tones_and_shock(chip: &str, rate: u32, path: &str) -> String {
+    format!(
+        "duration = 0.5\nrate = {rate}.0\nseed = 9\nmotion = \"static\"\n\
+         [chip]\nmodel = \"{chip}\"\n[vibration]\npath = \"{path}\"\n\
+         [[vibration.tones]]\nmotors = 4\nspread = 0.02\n\
+         rpm_ramp = {{ from = 6000, to = 18000, start = 0.1, end = 0.4 }}\n\
+         [[vibration.tones.harmonics]]\norder = 1.0\nlinear = [0.5, 0.0, 3.0]\n\
+         angular = [0.0, 0.2, 0.0]\n\
+         [[vibration.tones.harmonics]]\norder = 2.0\nlinear = [0.0, 1.0, 0.0]\n\
+         [[vibration.shocks]]\nat = 0.2\nduration = 0.011\nlinear = [0.0, 0.0, 200.0]\n\
+         angular = [1.0, 0.0, 0.0]\n"
+    )
+}
+
+#[test]
+fn source_model_runs_tones_and_shocks_on_the_device_byte_for_byte() {
+    for (chip, path) in [
+        ("icm20602", "output"),
+        ("icm20602", "internal"),
+        ("bmi088", "internal"),
+    ] {
+        let text = tones_and_shock(chip, 1000, path);
+        let (session, stdout, stderr, ok) = loopback_model(&text, &format!("model-{chip}-{path}"));
+        assert!(ok, "{chip} {path}: {stdout}{stderr}");
+        assert!(
+            stdout.contains("served 500 samples (0 underruns"),
+            "{chip} {path}: {stdout}"
+        );
+        let served = std::fs::read_to_string(session.join("served.csv")).unwrap();
+        assert_eq!(served.lines().count(), 501, "{chip} {path}");
+        assert!(
+            served.lines().skip(1).all(|l| l.ends_with(",1")),
+            "{chip} {path}: every image as predicted"
+        );
+    }
+}
+
+#[test]
+fn source_model_refuses_what_the_device_cannot_run_before_sending_anything() {
+    // Nine steps: 17 points (each step after the first is two points at one instant).
+    let steps: Vec<String> = (0..9)
+        .map(|i| format!("[{}.0, {}]", i, 6000 + 100 * i))
+        .collect();
+    let points = tones_and_shock("icm20602", 1000, "output").replace(
+        "rpm_ramp = { from = 6000, to = 18000, start = 0.1, end = 0.4 }",
+        &format!("rpm_steps = [{}]", steps.join(", ")),
     );
-    assert!(!dir.join("session/sent.csv").exists());
+    let cases = [
+        (
+            tones_and_shock("icm42688p", 8000, "internal"),
+            "the chain needs ≈ 15 800 instructions per output sample, 165 % of a 96 MHz \
+             Cortex-M4F at 8000 Hz",
+        ),
+        (
+            points,
+            "tone source 1 has 17 rpm points: the device holds at most 16 per source",
+        ),
+        (
+            random_scene("[[40.0, 0.002], [1500.0, 0.008]]", "")
+                .replace("duration = 8.0", "duration = 0.5"),
+            "the scene has random vibration ([[vibration.random]]): its synthesis needs FFT \
+             buffers",
+        ),
+    ];
+    for (i, (text, reason)) in cases.into_iter().enumerate() {
+        let (session, stdout, stderr, ok) = loopback_model(&text, &format!("model-refused-{i}"));
+        assert!(!ok, "{stdout}");
+        assert!(
+            stderr.contains(&format!(
+                "source mode model cannot run this scene: {reason}"
+            )),
+            "{stderr}"
+        );
+        assert!(!session.join("sent.csv").exists());
+    }
 }

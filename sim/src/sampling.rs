@@ -10,7 +10,9 @@
 //!   decimation ([`margemu_protocol::chip::chain`]): the cost grows with the internal rate.
 //! - A magnetometer-only device has none (vibration does not reach a magnetometer's reading).
 //!
-//! The firmware builds the very same [`DeviceChain`] in source mode (b), so both give the same
+//! In source mode (b) the device runs the same chain, built by the firmware's
+//! `margemu_firmware::link::setup::model_chain` (same periods, seed and order of sources) from
+//! the AddVibration messages; the host predicts with that constructor, so both give the same
 //! bits.
 
 use crate::scene::chip::ChipSetup;

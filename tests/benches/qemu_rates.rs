@@ -196,6 +196,7 @@ fn model(elf: &Path, rate: u32, o: &Options) -> Row {
     let predicted = stream.predicted_crcs();
     let script = Script {
         configure: stream.configure(50_000_000),
+        vibration: stream.vibration.clone(),
         samples: Samples::Kinematics(&stream.kinematics),
         sample_rate: stream.params.truth_rate,
         outputs: predicted.len() as u64,

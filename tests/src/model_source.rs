@@ -13,7 +13,7 @@ use margemu::scene::chip::ChipSetup;
 use margemu::scene::Scene;
 use margemu::stream::{predict_model, rate_of, ImageSettings, StreamError};
 use margemu_model::sensor::Truth;
-use margemu_protocol::link::{Configure, Image, ModelParams, Rate, Source, CRC32C};
+use margemu_protocol::link::{AddVibration, Configure, Image, ModelParams, Rate, Source, CRC32C};
 
 /// One scene prepared for source mode (b).
 #[derive(Clone, Debug)]
@@ -28,6 +28,8 @@ pub struct ModelStream {
     pub images: Vec<Image>,
     /// The scene's chip, whose Configure settings the images were converted with.
     pub chip: ChipSetup,
+    /// The AddVibration messages that follow Configure (the chain the device runs).
+    pub vibration: Vec<AddVibration>,
 }
 
 /// Why a scene cannot be streamed in source mode (b).
@@ -71,6 +73,7 @@ impl ModelStream {
         Ok(Self {
             out_rate,
             params: prediction.params,
+            vibration: prediction.vibration,
             kinematics,
             images,
             chip: scene.chip,

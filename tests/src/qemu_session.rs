@@ -131,6 +131,7 @@ pub fn run_images(
 pub fn model_script<'a>(stream: &'a ModelStream, configure: Configure) -> Script<'a> {
     Script {
         configure,
+        vibration: stream.vibration.clone(),
         samples: Samples::Kinematics(&stream.kinematics),
         sample_rate: stream.params.truth_rate,
         outputs: stream.images.len() as u64,

@@ -16,7 +16,9 @@
 //! byte), a payload that does not parse or images of another length than the chip's (3), a chip
 //! model (also a chip code this version does not know, detail the code), identity, image length
 //! or I2C address this device cannot emulate (4), a perturbation or a batch
-//! of the other source (5), a model the shared `Marg` refuses or a Configure while running (6),
+//! of the other source (5; detail 2 [`VIBRATION_IN_IMAGES`]: an AddVibration in source (a)), a
+//! model the shared `Marg` refuses, a Configure or AddVibration while running, or an
+//! AddVibration the model cannot hold (6; detail [`VIBRATION_REFUSED`]),
 //! Start or samples before Configure (7), a second Start while running (9). Samples beyond the
 //! credit limit are answered with Error 8 (detail: the first dropped index, truncated).
 //!
@@ -50,7 +52,9 @@
 //! **Source (b).** The host sends kinematics at `truth_rate`; at output instant `t` the device
 //! uses the latest kinematics sample `j` with `truth_rate.sample_time_ns(j) ≤ t` (sample and
 //! hold), steps the shared [`Marg`](margemu_model::sensor::Marg) (seeded from Configure, at the
-//! output rate) and converts with [`setup::model_image`]. The credit window counts kinematics
+//! output rate) behind the chain the AddVibration messages built (`setup::model_chain`: the
+//! output or internal path, tones and shocks) and converts with [`setup::model_image`]. The
+//! credit window counts kinematics
 //! indices. A magnetic perturbation is refused (Error 5, detail 1): its FFT buffers (tens to
 //! hundreds of KB) do not fit a generic no-alloc device.
 //!
@@ -78,9 +82,9 @@ pub use ring::{Insert, SampleRing};
 use margemu_model::sensor::Truth;
 use margemu_protocol::link::{max_images_per_batch, ServedBatch, ServedSample, CRC32C};
 use margemu_protocol::link::{
-    Accumulator, AddDevice, Bus, Buses, Capabilities, Configure, Credit, DeviceState, Encoder,
-    ErrorCode, ErrorReport, FeedResult, FirmwareVersion, Frame, Hello, HelloAck, Image, Kind,
-    Message, Modes, Rate, RegisterWrite, RegisterWriteBatch, Reset, ResetCause, RxStats,
+    Accumulator, AddDevice, AddVibration, Bus, Buses, Capabilities, Configure, Credit, DeviceState,
+    Encoder, ErrorCode, ErrorReport, FeedResult, FirmwareVersion, Frame, Hello, HelloAck, Image,
+    Kind, Message, Modes, Rate, RegisterWrite, RegisterWriteBatch, Reset, ResetCause, RxStats,
     SeqTracker, Source, Start, Telemetry, DEVICE_ID_LEN, MAX_WIRE_LEN,
 };
 use margemu_protocol::PROTOCOL_VERSION;
@@ -88,6 +92,13 @@ use margemu_protocol::PROTOCOL_VERSION;
 use crate::chip::{self, EmulatedChip};
 use rig::Rig;
 use setup::Model;
+
+/// Error 5's detail for an AddVibration in source (a): the chain is the host's there.
+pub const VIBRATION_IN_IMAGES: u32 = 2;
+/// Error 6's detail for an AddVibration the model cannot hold: a tone source or shock too many,
+/// or a chain the model refuses with it (an invalid source, filter settings the chip does not
+/// have at the rate).
+pub const VIBRATION_REFUSED: u32 = 7;
 
 /// The shortest image of any model (the standalone magnetometers).
 const SMALLEST_IMAGE_LEN: usize = margemu_protocol::regmap::mag_image::IMAGE_LEN;
@@ -378,6 +389,7 @@ impl<const N: usize> Core<N> {
             Message::Start(s) => self.start(s, seq, now_ns),
             Message::Stop => self.stop(now_ns),
             Message::AddDevice(a) => self.add_device(&a, seq),
+            Message::AddVibration(v) => self.add_vibration(&v, seq),
             Message::Images(b) => {
                 let configured = self.session.map(|s| usize::from(s.image_len));
                 if !b.images.is_empty() && configured.is_some_and(|n| n != b.images.image_len()) {
@@ -481,6 +493,21 @@ impl<const N: usize> Core<N> {
             // Within MAX_IMAGE_LEN (64): `Rig::add` refuses more.
             Ok(()) => session.image_len = self.rig.image_len() as u8,
             Err(e) => self.refuse(e.code, seq, e.detail),
+        }
+    }
+
+    fn add_vibration(&mut self, v: &AddVibration, seq: u16) {
+        if self.session.is_none() {
+            return self.refuse(ErrorCode::NotConfigured, seq, 0);
+        }
+        if self.state == DeviceState::Running {
+            return self.refuse(ErrorCode::InvalidConfig, seq, DeviceState::Running as u32);
+        }
+        let Some(model) = self.model.as_mut() else {
+            return self.refuse(ErrorCode::UnsupportedMode, seq, VIBRATION_IN_IMAGES);
+        };
+        if !model.add_vibration(v, self.rig.primary()) {
+            self.refuse(ErrorCode::InvalidConfig, seq, VIBRATION_REFUSED);
         }
     }
 

@@ -1,10 +1,17 @@
 //! Applying a [`Configure`]: the chip (model, identity, image length, I2C address), its register
 //! overrides, and the model of source mode (b).
 
-use margemu_model::chain::Clipper;
+#[cfg(feature = "model-vibration")]
+use margemu_model::chain::Front;
+use margemu_model::chain::{Clipper, DeviceChain};
+use margemu_model::perturbation::Complex;
 use margemu_model::sensor::{Marg, Truth};
-use margemu_protocol::chip::PhysicalSample;
-use margemu_protocol::link::{Chips, Configure, ErrorCode, Image, ModelParams, Rate, Source};
+use margemu_model::vibration::{Shock, ToneSource, MAX_SHOCKS, MAX_TONE_SOURCES};
+use margemu_protocol::chip::chain::ChainConfig;
+use margemu_protocol::chip::{ChipSettings, PhysicalSample};
+use margemu_protocol::link::{
+    AddVibration, Chips, Configure, ErrorCode, Image, ModelParams, Rate, RpmProfile, Source,
+};
 
 use crate::chip::{Chip, EmulatedChip};
 
@@ -33,50 +40,214 @@ pub fn build_chip(cfg: &Configure) -> Result<EmulatedChip, ErrorCode> {
     Ok(chip)
 }
 
-/// The sensor model of source mode (b) at the output rate: the front end of the output path
-/// without vibration (a [`Clipper`]: clipping at the chip's full scale, counted) and the error
-/// terms. The host's model of a device without vibration is the same.
+/// What the AddVibration messages of source mode (b) built up (`docs/spec/link.md` §5.15):
+/// the chain's path and the vibration reaching the device, in the chip's axes, in the order
+/// received (tones, then shocks, as the host's model adds them).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ChainSetup {
+    /// The chip's filter settings for its internal path (`None`: the output path).
+    pub internal: Option<ChainConfig>,
+    /// The motor tone sources.
+    pub tones: heapless::Vec<ToneSource<RpmProfile>, TONES_HELD>,
+    /// The shocks.
+    pub shocks: heapless::Vec<Shock, SHOCKS_HELD>,
+}
+
+impl ChainSetup {
+    /// Adds one piece; `false` (nothing changed) if it does not fit.
+    pub fn add(&mut self, piece: &AddVibration) -> bool {
+        match piece {
+            AddVibration::Path(p) if p.is_none() || cfg!(feature = "model-vibration") => {
+                self.internal = *p;
+                true
+            }
+            AddVibration::Path(_) => false,
+            AddVibration::Tones(t) => self.tones.push(t.clone()).is_ok(),
+            AddVibration::Shock(s) => self.shocks.push(*s).is_ok(),
+        }
+    }
+
+    /// The messages that build this setup: the path, each tone source, each shock.
+    pub fn messages(&self) -> impl Iterator<Item = AddVibration> + '_ {
+        let path = core::iter::once(AddVibration::Path(self.internal));
+        let tones = self.tones.iter().cloned().map(AddVibration::Tones);
+        path.chain(tones)
+            .chain(self.shocks.iter().copied().map(AddVibration::Shock))
+    }
+}
+
+/// A device's chain in source mode (b): rpm profiles of at most
+/// [`MAX_RPM_POINTS`](margemu_protocol::link::MAX_RPM_POINTS) points, no random vibration (its
+/// FFT buffers do not fit: the host refuses it).
+pub type ModelChain = DeviceChain<RpmProfile, [Complex; 0]>;
+/// Tone sources a device holds: the model's limit with the `model-vibration` feature, none
+/// without.
+pub const TONES_HELD: usize = if cfg!(feature = "model-vibration") {
+    MAX_TONE_SOURCES
+} else {
+    0
+};
+/// Shocks a device holds, likewise.
+pub const SHOCKS_HELD: usize = if cfg!(feature = "model-vibration") {
+    MAX_SHOCKS
+} else {
+    0
+};
+
+/// A device's front end in source mode (b): the [`Clipper`] when nothing vibrates on the output
+/// path, else a [`ModelChain`].
+#[cfg(feature = "model-vibration")]
+pub type ModelFront = Front<RpmProfile, [Complex; 0]>;
+
+/// A device's front end in source mode (b) without the `model-vibration` feature: the
+/// [`Clipper`] alone (the chain's vibration is refused).
+#[cfg(not(feature = "model-vibration"))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelFront(Clipper);
+
+#[cfg(not(feature = "model-vibration"))]
+impl ModelFront {
+    /// One output sample of `marg` behind the clipper.
+    #[inline]
+    pub fn sample(
+        &mut self,
+        marg: &mut Marg,
+        _t_ns: u64,
+        truth: &Truth,
+    ) -> margemu_model::sensor::Sample {
+        self.0.sample(marg, truth)
+    }
+
+    /// Samples clipped so far, `[accel, gyro]` per axis.
+    pub fn clips(&self) -> [[u64; 3]; 2] {
+        self.0.clips()
+    }
+}
+
+/// The front end of a chip with `settings` at the output `rate`, seeded with `seed`, as `setup`
+/// says (`None` for a magnetometer-only chip: vibration does not reach it): the [`Clipper`]
+/// when nothing vibrates on the output path, else the chain. Built exactly as the host's
+/// `margemu_sim::sampling::build`: the output path at the output period rounded to
+/// ns, or the chip's declared chain ([`ChipChain::new`]) at its internal periods; each sensor's
+/// vibration adds the tone sources then the shocks, in order.
+pub fn model_chain(
+    settings: &ChipSettings,
+    rate: Rate,
+    seed: u64,
+    setup: &ChainSetup,
+) -> Option<Result<ModelFront, margemu_model::Error>> {
+    let [accel, gyro] = settings.front_end_ranges()?;
+    if setup.internal.is_none() && setup.tones.is_empty() && setup.shocks.is_empty() {
+        #[cfg(feature = "model-vibration")]
+        return Some(Clipper::new(accel, gyro).map(Front::Clip));
+        #[cfg(not(feature = "model-vibration"))]
+        return Some(Clipper::new(accel, gyro).map(ModelFront));
+    }
+    Some(vibration_chain(settings, rate, seed, setup, [accel, gyro]))
+}
+
+/// Without the `model-vibration` feature the device holds no chain: refused.
+#[cfg(not(feature = "model-vibration"))]
+fn vibration_chain(
+    _: &ChipSettings,
+    _: Rate,
+    _: u64,
+    _: &ChainSetup,
+    _: [f32; 2],
+) -> Result<ModelFront, margemu_model::Error> {
+    Err(margemu_model::Error::ChainRefused)
+}
+
+/// The chain with vibration or on the internal path (see [`model_chain`]).
+#[cfg(feature = "model-vibration")]
+fn vibration_chain(
+    settings: &ChipSettings,
+    rate: Rate,
+    seed: u64,
+    setup: &ChainSetup,
+    [accel, gyro]: [f32; 2],
+) -> Result<ModelFront, margemu_model::Error> {
+    use margemu_model::chain::SensorPath;
+    use margemu_model::vibration::{Sense, Vibration};
+    use margemu_protocol::chip::chain::{ChipChain, SensorChain};
+    let vibration = |sense, period_ns| -> Result<_, margemu_model::Error> {
+        let mut vib = Vibration::new(sense, period_ns, seed);
+        for tones in &setup.tones {
+            vib.add_tones(tones.clone())?;
+        }
+        for shock in &setup.shocks {
+            vib.add_shock(shock)?;
+        }
+        Ok(vib)
+    };
+    match &setup.internal {
+        None => {
+            let period = libm::round(1e9 / rate.as_hz_f64()).max(1.0) as u64;
+            let path = |sense, range| SensorPath::at_output(range, vibration(sense, period)?);
+            Ok(Front::Chain(DeviceChain {
+                accel: path(Sense::Linear, accel)?,
+                gyro: path(Sense::Angular, gyro)?,
+            }))
+        }
+        Some(config) => {
+            let declared = ChipChain::new(settings, config, rate)
+                .map_err(|_| margemu_model::Error::ChainRefused)?;
+            let path = |sense, spec: &SensorChain| {
+                let vib = vibration(sense, spec.period_ns)?;
+                SensorPath::new(spec.period_ns, spec.filter, spec.range, vib)
+            };
+            Ok(Front::Chain(DeviceChain {
+                accel: path(Sense::Linear, &declared.accel)?,
+                gyro: path(Sense::Angular, &declared.gyro)?,
+            }))
+        }
+    }
+}
+
+/// The sensor model of source mode (b) at the output rate: the chain of [`model_chain`]
+/// (clipping at the chip's full scale, counted; the vibration and path of a [`ChainSetup`])
+/// and the error terms. The host predicts with the same ([`DeviceModel::new`] on both sides).
 pub struct DeviceModel {
     marg: Marg,
-    front: Option<Clipper>,
+    front: Option<ModelFront>,
 }
 
 impl DeviceModel {
-    /// The model of `cfg` at `rate_hz` with `seed`, clipping at `chip`'s full scale (none for a
-    /// magnetometer-only chip).
+    /// The model of `cfg` at the output `rate` with `seed`, behind the chain `setup` gives
+    /// `chip` (none for a magnetometer-only chip).
     pub fn new(
         cfg: &margemu_model::sensor::MargConfig,
-        rate_hz: f64,
+        rate: Rate,
         seed: u64,
         chip: &impl Chip,
+        setup: &ChainSetup,
     ) -> Result<Self, margemu_model::Error> {
-        let marg = Marg::new(cfg, rate_hz, seed)?;
-        let front = match chip.settings().front_end_ranges() {
-            None => None,
-            Some([accel, gyro]) => Some(Clipper::new(accel, gyro)?),
-        };
+        let marg = Marg::new(cfg, rate.as_hz_f64(), seed)?;
+        let front = model_chain(&chip.settings(), rate, seed, setup).transpose()?;
         Ok(Self { marg, front })
     }
 
     /// One output sample at `t_ns` from `truth`.
     #[inline]
     pub fn sample(&mut self, t_ns: u64, truth: &Truth) -> margemu_model::sensor::Sample {
-        let _ = t_ns;
         match self.front.as_mut() {
-            Some(front) => front.sample(&mut self.marg, truth),
+            Some(front) => front.sample(&mut self.marg, t_ns, truth),
             None => self.marg.sample(truth),
         }
     }
 
     /// Front-end clipping so far, `[accel, gyro]` per axis (zeros without a front end).
     pub fn clips(&self) -> [[u64; 3]; 2] {
-        self.front.as_ref().map_or([[0; 3]; 2], Clipper::clips)
+        self.front.as_ref().map_or([[0; 3]; 2], ModelFront::clips)
     }
 }
 
 /// Source mode (b): the shared sensor model at the output rate, fed by the latest kinematics.
 pub struct Model {
     model: DeviceModel,
+    params: ModelParams,
+    rate: Rate,
+    chain: ChainSetup,
     truth_rate: Rate,
     mag_ut_per_unit: f64,
     held: Option<Truth>,
@@ -86,13 +257,42 @@ impl Model {
     /// The model of `params` at the output `rate`; `None` if the model refuses the terms.
     /// A perturbation is refused by the caller (it needs buffers this device does not have).
     pub fn new(params: &ModelParams, rate: Rate, chip: &impl Chip) -> Option<Self> {
-        let model = DeviceModel::new(&params.marg, rate.as_hz_f64(), params.seed, chip).ok()?;
+        let chain = ChainSetup::default();
+        let model = DeviceModel::new(&params.marg, rate, params.seed, chip, &chain).ok()?;
         Some(Self {
             model,
+            params: *params,
+            rate,
+            chain,
             truth_rate: params.truth_rate,
             mag_ut_per_unit: params.mag_ut_per_unit,
             held: None,
         })
+    }
+
+    /// Adds one piece of the chain (an AddVibration) and rebuilds the model behind it, fresh
+    /// (before Start); `false`, with nothing changed, if the piece does not fit
+    /// ([`MAX_TONE_SOURCES`] tone sources, [`MAX_SHOCKS`] shocks) or the model refuses the chain
+    /// with it (an invalid source, a chain the chip's settings do not have at this rate).
+    pub fn add_vibration(&mut self, piece: &AddVibration, chip: &impl Chip) -> bool {
+        let mut chain = self.chain.clone();
+        if !chain.add(piece) {
+            return false;
+        }
+        let p = &self.params;
+        match DeviceModel::new(&p.marg, self.rate, p.seed, chip, &chain) {
+            Ok(model) => {
+                self.model = model;
+                self.chain = chain;
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// The chain's setup so far.
+    pub fn chain(&self) -> &ChainSetup {
+        &self.chain
     }
 
     /// The kinematics index in effect at scene time `t_ns`: the latest `j` with

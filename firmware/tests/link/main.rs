@@ -10,3 +10,4 @@ mod rig;
 mod robustness;
 mod session;
 mod streaming;
+mod vibration;

@@ -215,6 +215,9 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
         for add in self.session.add_device_messages() {
             self.send(&Message::AddDevice(add))?;
         }
+        for piece in self.session.add_vibration_messages() {
+            self.send(&Message::AddVibration(piece))?;
+        }
         let timeout = self.plan.hello_timeout();
         let deadline = self.now() + timeout.as_nanos() as u64;
         while !self.reports.credit_seen() {

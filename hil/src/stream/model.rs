@@ -12,8 +12,8 @@
 //!   none);
 //! - **the device** (`margemu_firmware::link`, `docs/spec/link.md` §5.3.1) serves output
 //!   sample `k` from the latest kinematics at or before `t_k`, i.e. `j = k / hold` (zero-order
-//!   hold), steps its model ([`Marg`] with the scene's terms and seed at `rate.as_hz_f64()`)
-//!   once per output instant, scales the field to µT as `(f64::from(mag) * mag_ut_per_unit) as
+//!   hold), steps its model ([`Marg`](margemu_model::sensor::Marg) with the scene's terms and
+//!   seed at `rate.as_hz_f64()`, behind the scene's sampling chain) once per output instant, scales the field to µT as `(f64::from(mag) * mag_ut_per_unit) as
 //!   f32`, takes the die temperature of the kinematics (21 °C without one) and converts with
 //!   the settings of the chip the scene's Configure builds (the firmware's own
 //!   `setup::build_chip` and `setup::model_image`, so host and device share every step).
@@ -22,10 +22,17 @@
 //! say). The prediction holds while the device under test leaves the full-scale and offset
 //! registers where Configure put them (the device converts with the chip's current settings).
 //!
+//! **The sampling chain.** The device's model runs behind the scene's chain
+//! ([`model_chain_setup`]: device 0's tones and shocks in the chip's axes, on the path the host
+//! would take), which the session sends after Configure as AddVibration messages
+//! ([`ModelPrediction::vibration`]); host and device build it with the one constructor
+//! `setup::model_chain`, so the images stay bit-identical.
+//!
 //! Scenes the device cannot run are refused before anything is sent ([`StreamError::Model`]):
-//! a magnetic perturbation (its generator's FFT buffers do not fit a no-alloc device), image
-//! settings other than those of the configured chip, and a kinematics rate that does not divide
-//! the output rate.
+//! a magnetic perturbation or random vibration (their FFT buffers do not fit a no-alloc
+//! device), more rpm points, tone sources or shocks than the device holds, a chain too slow for
+//! a 96 MHz Cortex-M4F at the scene's rate ([`chain_cost`]), image settings other than those of
+//! the configured chip, and a kinematics rate that does not divide the output rate.
 //!
 //! ```
 //! use margemu_sim::scene::Scene;
@@ -47,9 +54,12 @@ use super::predictor::{run_scene, Predictions};
 use super::session::rate_of;
 use super::StreamError;
 use margemu_firmware::chip::{Chip, EmulatedChip};
-use margemu_firmware::link::setup::{self, DeviceModel};
+use margemu_firmware::link::setup::{self, ChainSetup, DeviceModel, ModelFront};
+use margemu_model::chain::Front;
 use margemu_model::sensor;
-use margemu_protocol::link::{Image, ModelParams, Rate};
+use margemu_model::vibration::{Sense, ToneSource, MAX_SHOCKS, MAX_TONE_SOURCES};
+use margemu_protocol::link::{AddVibration, Image, ModelParams, Rate, RpmProfile, MAX_RPM_POINTS};
+use margemu_sim::sampling::uses_internal_path;
 use margemu_sim::scene::chip::ChipSetup;
 use margemu_sim::scene::Scene;
 use margemu_sim::truth::Truth;
@@ -64,6 +74,9 @@ pub struct ModelPrediction {
     pub hold: u32,
     /// What Configure carries: seed, kinematics rate, µT per unit, the model terms.
     pub params: ModelParams,
+    /// The AddVibration messages that follow Configure: the chain's path, each tone source,
+    /// each shock ([`model_chain_setup`]).
+    pub vibration: Vec<AddVibration>,
     /// Every output sample in order: its truth, the image the device will serve, and the
     /// kinematics sample due at its instant (every `hold`-th sample's, from sample 0).
     pub samples: Predictions<ModelSample>,
@@ -101,10 +114,8 @@ pub fn predict_model(
                 .into(),
         });
     }
-    if let Some(reason) = vibration_refusal(scene) {
-        return Err(StreamError::Model { reason });
-    }
     let rate = rate_of(scene)?;
+    let chain = model_chain_setup(scene, rate).map_err(|reason| StreamError::Model { reason })?;
     let chip = device_chip(&scene.chip, rate)?;
     if settings.chip != chip.settings() {
         return Err(StreamError::Model {
@@ -120,8 +131,9 @@ pub fn predict_model(
         ..ModelParams::new(scene.spec.seed, truth_rate, scene.spec.sensors.config())
     };
     let scene = scene.clone();
+    let vibration = chain.messages().collect();
     let samples = Predictions::spawn(move |emit| {
-        let mut model = DeviceModel::new(&params.marg, rate.as_hz_f64(), params.seed, &chip)
+        let mut model = DeviceModel::new(&params.marg, rate, params.seed, &chip, &chain)
             .map_err(margemu_sim::run::RunError::Model)?;
         let temperature = scene.spec.sensors.temperature;
         let (mut k, mut held) = (0u64, None);
@@ -150,31 +162,159 @@ pub fn predict_model(
     Ok(ModelPrediction {
         hold,
         params,
+        vibration,
         samples,
     })
 }
 
-/// Why source mode (b) cannot run `scene`'s sampling chain, if it cannot: vibration, or the
-/// chip's internal-rate path asked for. The device's model runs at the output rate from held
-/// kinematics; the vibration sources and the internal-rate filters are not carried by the link.
+/// Why source mode (b) cannot run `scene`'s sampling chain, if it cannot
+/// ([`model_chain_setup`]'s refusal).
 pub fn vibration_refusal(scene: &Scene) -> Option<String> {
-    let vibrates = scene.vibration.iter().any(|v| !v.is_empty());
-    let internal = scene.sampling == margemu_sim::scene::vibration::SamplingPath::Internal;
-    (vibrates || internal).then(|| {
-        format!(
-            "the scene has {}: source mode (b) runs the sensor model on the device at the \
-             output rate from held kinematics, without vibration or the chip's internal-rate \
-             filters (the chain costs the Cortex-M4F {}; see the guide's sampling-chain \
-             figures); stream it as register images (source images), where the host runs the \
-             chain",
-            if vibrates {
-                "[vibration]"
-            } else {
-                "[vibration] path = \"internal\""
-            },
-            "thousands of instructions per output sample at 8 kHz"
-        )
-    })
+    let rate = rate_of(scene).ok()?;
+    model_chain_setup(scene, rate).err()
+}
+
+/// Instructions per output sample of the sensor model and the bookkeeping of an output-path
+/// chain without vibration, on the Cortex-M4F (`docs/figures.md`, "Sampling chain on the
+/// Cortex-M4F": 1 459 on the output path, 1 666 on the ICM-20602's internal path, 4 931 on the
+/// ICM-42688-P's, fitted with the costs below).
+pub const COST_BASE: f64 = 1000.0;
+/// Instructions per sensor and step of the output path (2 × 230 + 1 000 ≈ 1 459).
+pub const COST_OUTPUT_STEP: f64 = 230.0;
+/// Instructions per sensor and internal sample of the internal path, filters and clipping
+/// ((4 931 − 1 666) / (8 + 8 − 1 − 0.5) ≈ 500 per step).
+pub const COST_FILTER_STEP: f64 = 500.0;
+/// Instructions per tone (source × motor × harmonic) or shock, per sensor sample: the f32 sine
+/// of the phase in cycles, as measured on the M4F since tones use it (output path with
+/// 4 motors × 2 harmonics on both sensors at 8 kHz: 3 500–4 000; the ICM-42688-P's internal
+/// path with them and a shock: ≈ 14 500; the figures table's tone rows predate that sine).
+pub const COST_TONE: f64 = 150.0;
+/// Instructions per second of a 96 MHz Cortex-M4F at 1.25 cycles per instruction, doing
+/// nothing else.
+pub const M4F_INSTRUCTIONS_PER_S: f64 = 96e6 / 1.25;
+
+/// What source mode (b)'s chain is on the device for `scene` at `rate` (device 0's vibration in
+/// the chip's axes, the path `margemu_sim::sampling::uses_internal_path` picks, the chip's
+/// declared filters), or why the device cannot run it, before anything is sent:
+///
+/// - random vibration (its synthesis needs FFT buffers the device does not have);
+/// - a tone source of more than [`MAX_RPM_POINTS`] rpm points, more than
+///   [`MAX_TONE_SOURCES`] tone sources or [`MAX_SHOCKS`] shocks;
+/// - a chain the model refuses;
+/// - a chain too slow for a 96 MHz Cortex-M4F at the scene's rate: [`chain_cost`] instructions
+///   per output sample above [`M4F_INSTRUCTIONS_PER_S`] / rate.
+pub fn model_chain_setup(scene: &Scene, rate: Rate) -> Result<ChainSetup, String> {
+    let advice = "stream it as register images (source images), where the host runs the chain";
+    let vibration = scene.vibration.first().cloned().unwrap_or_default();
+    if vibration.random.is_some() {
+        return Err(format!(
+            "the scene has random vibration ([[vibration.random]]): its synthesis needs FFT \
+             buffers (tens of KB) the device does not have; {advice}"
+        ));
+    }
+    let mut setup = ChainSetup {
+        internal: match uses_internal_path(scene, &vibration) {
+            true => scene.chip.chain,
+            false => None,
+        },
+        ..ChainSetup::default()
+    };
+    for (i, t) in vibration.tones.iter().enumerate() {
+        let profile = RpmProfile::from_slice(&t.profile).map_err(|_| {
+            format!(
+                "tone source {} has {} rpm points: the device holds at most {MAX_RPM_POINTS} per \
+                 source; {advice}",
+                i + 1,
+                t.profile.len()
+            )
+        })?;
+        let mut tones = ToneSource::new(t.motors, profile);
+        tones.spread = t.spread;
+        for h in t.harmonics() {
+            tones.push(*h).map_err(|e| e.to_string())?;
+        }
+        setup.tones.push(tones).map_err(|_| {
+            format!(
+                "the scene has {} tone sources: the device holds at most {MAX_TONE_SOURCES}; \
+                 {advice}",
+                vibration.tones.len()
+            )
+        })?;
+    }
+    for shock in &vibration.shocks {
+        setup.shocks.push(*shock).map_err(|_| {
+            format!(
+                "the scene has {} shocks: the device holds at most {MAX_SHOCKS}; {advice}",
+                vibration.shocks.len()
+            )
+        })?;
+    }
+    let chain = setup::model_chain(&scene.chip.settings, rate, scene.spec.seed, &setup);
+    if let Some(chain) = chain {
+        let chain = chain.map_err(|e| format!("the device's model refuses the chain: {e}"))?;
+        let cost = chain_cost(&setup, &chain, rate);
+        let hz = rate.as_hz_f64();
+        let share = cost * hz / M4F_INSTRUCTIONS_PER_S;
+        if share > 1.0 {
+            return Err(format!(
+                "the chain needs ≈ {} instructions per output sample, {:.0} % of a 96 MHz \
+                 Cortex-M4F at {hz} Hz (cost model: {COST_BASE} + per sensor sample \
+                 {COST_FILTER_STEP} on the internal path or {COST_OUTPUT_STEP} on the output \
+                 path + {COST_TONE} per tone (source × motor × harmonic) or shock and sensor \
+                 sample; 1.25 cycles per instruction); {advice}",
+                grouped(cost.round() as u64),
+                share * 100.0
+            ));
+        }
+    }
+    Ok(setup)
+}
+
+/// Instructions per output sample of `chain` (built from `setup`) on the Cortex-M4F at `rate`
+/// (the cost model of [`COST_BASE`], [`COST_OUTPUT_STEP`], [`COST_FILTER_STEP`],
+/// [`COST_TONE`]): per sensor, its samples per output sample times its step's cost and its
+/// tones and shocks.
+pub fn chain_cost(setup: &ChainSetup, chain: &ModelFront, rate: Rate) -> f64 {
+    let out_ns = 1e9 / rate.as_hz_f64();
+    let sensor = |sense: Sense, period_ns: u64| {
+        let (samples, step) = match period_ns {
+            0 => (1.0, COST_OUTPUT_STEP),
+            p => (out_ns / p as f64, COST_FILTER_STEP),
+        };
+        let tones: usize = setup
+            .tones
+            .iter()
+            .filter(|t| t.moves(sense))
+            .map(|t| usize::from(t.motors) * t.harmonics().len())
+            .sum();
+        let shocks = setup
+            .shocks
+            .iter()
+            .filter(|s| match sense {
+                Sense::Linear => s.linear != [0.0; 3],
+                Sense::Angular => s.angular != [0.0; 3],
+            })
+            .count();
+        samples * (step + COST_TONE * (tones + shocks) as f64)
+    };
+    let (accel_ns, gyro_ns) = match chain {
+        Front::Clip(_) => (0, 0),
+        Front::Chain(c) => (c.accel.period_ns(), c.gyro.period_ns()),
+    };
+    COST_BASE + sensor(Sense::Linear, accel_ns) + sensor(Sense::Angular, gyro_ns)
+}
+
+/// `n` with its thousands apart: `14 500`.
+fn grouped(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
 }
 
 /// The chip a device builds from the Configure of `chip` at `rate`: what it converts with.
@@ -188,16 +328,18 @@ pub fn device_chip(chip: &ChipSetup, rate: Rate) -> Result<EmulatedChip, StreamE
 }
 
 /// The images the device serves at output samples `0 .. samples` in source mode (b), from
-/// `kinematics` held for `hold` output samples each, converted by `chip` (see the module docs).
+/// `kinematics` held for `hold` output samples each, behind the chain `chain` builds, converted
+/// by `chip` (see the module docs).
 pub fn model_images(
     params: &ModelParams,
     rate: Rate,
+    chain: &ChainSetup,
     hold: u32,
     kinematics: &[sensor::Truth],
     samples: usize,
     chip: &impl Chip,
 ) -> Result<Vec<Image>, StreamError> {
-    let mut model = DeviceModel::new(&params.marg, rate.as_hz_f64(), params.seed, chip)
+    let mut model = DeviceModel::new(&params.marg, rate, params.seed, chip, chain)
         .map_err(margemu_sim::run::RunError::Model)?;
     let held = (0..samples).filter_map(|k| {
         let t = kinematics.get(k / hold.max(1) as usize)?;
@@ -297,6 +439,73 @@ mod tests {
                 "{model:?} at its largest ranges"
             );
         }
+    }
+
+    #[test]
+    fn the_prediction_runs_the_scenes_chain_and_sends_it() {
+        let base = "duration = 0.1\nrate = 1000.0\nseed = 3\nmotion = \"static\"\n\
+                    [chip]\nmodel = \"icm20602\"\n";
+        let tone = "[[vibration.tones]]\nmotors = 2\nrpm = 6000\n\
+                    [[vibration.tones.harmonics]]\norder = 1.0\nlinear = [0.0, 0.0, 5.0]\n\
+                    [[vibration.shocks]]\nat = 0.05\nduration = 0.01\nangular = [1.0, 0.0, 0.0]\n";
+        let images = |text: &str| {
+            let scene = Scene::parse_str(text, std::path::Path::new("s.toml")).unwrap();
+            let p = predict_model(&scene, &ImageSettings::for_scene(&scene), None).unwrap();
+            let images: Vec<Image> = p.samples.map(|s| s.unwrap().sample.image).collect();
+            (p.vibration, images)
+        };
+        let (quiet_msgs, quiet) = images(base);
+        assert_eq!(quiet_msgs, [AddVibration::Path(None)]);
+        let (msgs, shaken) = images(&format!("{base}{tone}"));
+        assert!(matches!(
+            msgs.as_slice(),
+            [AddVibration::Path(None), AddVibration::Tones(t), AddVibration::Shock(_)]
+                if t.motors == 2 && t.profile.len() == 1
+        ));
+        let differ = quiet.iter().zip(&shaken).filter(|(a, b)| a != b).count();
+        assert!(differ > 90, "{differ} of 100 images differ");
+        let (msgs, _) = images(&format!("{base}[vibration]\npath = \"internal\"\n{tone}"));
+        assert!(matches!(msgs.first(), Some(AddVibration::Path(Some(_)))));
+    }
+
+    #[test]
+    fn the_cost_model_matches_the_measured_cases() {
+        // The measured cases: 4 motors × 2 harmonics on both sensors and a shock, 8 kHz.
+        let base = "duration = 0.01\nrate = 8000.0\nseed = 3\nmotion = \"static\"\n";
+        let tones = "[[vibration.tones]]\nmotors = 4\nrpm = 6000\n\
+                     [[vibration.tones.harmonics]]\norder = 1.0\nlinear = [0.0, 0.0, 1.0]\n\
+                     angular = [0.1, 0.0, 0.0]\n\
+                     [[vibration.tones.harmonics]]\norder = 2.0\nlinear = [1.0, 0.0, 0.0]\n\
+                     angular = [0.1, 0.0, 0.0]\n";
+        let cost = |chip: &str, path: &str, extra: &str| {
+            let text = format!(
+                "{base}[chip]\nmodel = \"{chip}\"\n[vibration]\npath = \"{path}\"\n{extra}"
+            );
+            let scene = Scene::parse_str(&text, std::path::Path::new("s.toml")).unwrap();
+            let rate = rate_of(&scene).unwrap();
+            let mut setup = ChainSetup {
+                internal: (path == "internal").then_some(scene.chip.chain).flatten(),
+                ..ChainSetup::default()
+            };
+            for t in &scene.vibration[0].tones {
+                let mut tones =
+                    ToneSource::new(t.motors, RpmProfile::from_slice(&t.profile).unwrap());
+                t.harmonics().iter().for_each(|h| tones.push(*h).unwrap());
+                setup.tones.push(tones).unwrap();
+            }
+            let chain = setup::model_chain(&scene.chip.settings, rate, 3, &setup);
+            chain_cost(&setup, &chain.unwrap().unwrap(), rate)
+        };
+        // Measured: 1 459, 1 666, 4 931 quiet; ≈ 3 500–4 000 with tones at 8 kHz; ≈ 14 500 on
+        // the ICM-42688-P's internal path with tones.
+        assert_eq!(cost("icm20602", "output", ""), 1460.0);
+        assert_eq!(cost("icm20602", "internal", ""), 1750.0);
+        assert_eq!(cost("icm42688p", "internal", ""), 5000.0);
+        assert_eq!(cost("icm20602", "output", tones), 3860.0);
+        assert_eq!(cost("icm20602", "internal", tones), 3550.0);
+        assert_eq!(cost("icm42688p", "internal", tones), 14600.0);
+        assert_eq!(grouped(14600), "14 600");
+        assert_eq!(grouped(999), "999");
     }
 
     #[test]

@@ -128,6 +128,7 @@ impl Session {
                 let items = Items::Kinematics {
                     params: Box::new(p.params),
                     hold: p.hold,
+                    vibration: p.vibration,
                 };
                 (Prediction::model(p.samples), items, Some(p.hold))
             }
@@ -215,12 +216,17 @@ impl Session {
         self.source.refusal(caps)
     }
 
-    /// Configure for this session.
     /// One AddDevice per other device of a rig, to follow Configure.
     pub(super) fn add_device_messages(&self) -> Vec<margemu_protocol::link::AddDevice> {
         self.source.add_device_messages()
     }
 
+    /// The AddVibration messages of source model, to follow Configure.
+    pub(super) fn add_vibration_messages(&self) -> Vec<margemu_protocol::link::AddVibration> {
+        self.source.add_vibration_messages().to_vec()
+    }
+
+    /// Configure for this session.
     pub(super) fn configure_message(&self) -> Configure {
         let period = self.config.telemetry_period.as_nanos() as u64;
         self.source.configure_message(period)

@@ -23,9 +23,9 @@ use super::window::Window;
 use super::{ModelSample, StreamError};
 use margemu_model::sensor;
 use margemu_protocol::link::{
-    self, max_images_per_batch, AddDevice, Capabilities, Configure, Encoder, Image, ImageBatch,
-    KinematicsBatch, Message, ModelParams, Modes, Rate, CRC32C, MAX_KINEMATICS_PER_BATCH,
-    TRUTH_LEN,
+    self, max_images_per_batch, AddDevice, AddVibration, Capabilities, Configure, Encoder, Image,
+    ImageBatch, KinematicsBatch, Message, ModelParams, Modes, Rate, CRC32C,
+    MAX_KINEMATICS_PER_BATCH, TRUTH_LEN,
 };
 use margemu_sim::run::RunError;
 use margemu_sim::scene::chip::ChipSetup;
@@ -43,6 +43,8 @@ pub(super) enum Items {
         /// Output samples per kinematics sample: kinematics sample `j` is output sample
         /// `j · hold`'s, due at `params.truth_rate.sample_time_ns(j)`.
         hold: u32,
+        /// The AddVibration messages that follow Configure (the chain the device runs).
+        vibration: Vec<AddVibration>,
     },
 }
 
@@ -310,6 +312,15 @@ impl Source {
             .iter()
             .map(|c| c.add_device(self.rate))
             .collect()
+    }
+
+    /// The AddVibration messages of source model, in order, to follow Configure (none in
+    /// source images).
+    pub(super) fn add_vibration_messages(&self) -> &[AddVibration] {
+        match &self.items {
+            Items::Images => &[],
+            Items::Kinematics { vibration, .. } => vibration,
+        }
     }
 
     /// Encodes the batch of items `first .. first + n` into `wire`; returns its length.

@@ -60,6 +60,9 @@ impl Host {
         }))?;
         self.wait("HelloAck", |h| h.ack.is_some_and(|a| a.session == session))?;
         self.send(&Message::Configure(script.configure.clone()))?;
+        for piece in &script.vibration {
+            self.send(&Message::AddVibration(piece.clone()))?;
+        }
         self.wait("the first Credit", |h| h.credit_seen)?;
 
         let samples = script.samples;

@@ -87,6 +87,8 @@ impl Samples<'_> {
 pub struct Script<'a> {
     /// Sent after the handshake (its rate is the output rate).
     pub configure: Configure,
+    /// Sent after Configure, in order (source (b)'s sampling chain).
+    pub vibration: Vec<margemu_protocol::link::AddVibration>,
     /// The samples.
     pub samples: Samples<'a>,
     /// Rate of `samples`: the output rate for images, the truth rate for kinematics.

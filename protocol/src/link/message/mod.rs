@@ -11,6 +11,7 @@
 //! | 0x03 | [`Start`] | host → device |
 //! | 0x04 | [`Message::Stop`] | host → device |
 //! | 0x05 | [`AddDevice`] | host → device |
+//! | 0x06 | [`AddVibration`] | host → device |
 //! | 0x10 | [`ImageBatch`] | host → device |
 //! | 0x11 | [`KinematicsBatch`] | host → device |
 //! | 0x81 | [`HelloAck`] | device → host |
@@ -42,6 +43,7 @@ mod images;
 mod model_terms;
 mod session;
 mod status;
+mod vibration;
 
 pub use batch::{
     Bus, Items, KinematicsBatch, RegisterWrite, RegisterWriteBatch, ServedBatch, ServedSample,
@@ -60,6 +62,7 @@ pub use session::{
     Reset, ResetCause, Start, DEVICE_ID_LEN,
 };
 pub use status::{Credit, DeviceState, Telemetry, TELEMETRY_LEN};
+pub use vibration::{AddVibration, RpmProfile, MAX_RPM_POINTS};
 
 use super::wire::{Reader, Writer};
 use super::{Error, MAX_PAYLOAD_LEN};
@@ -77,6 +80,8 @@ code_enum! {
         Stop = 0x04,
         /// [`AddDevice`].
         AddDevice = 0x05,
+        /// [`AddVibration`].
+        AddVibration = 0x06,
         /// [`ImageBatch`].
         Images = 0x10,
         /// [`KinematicsBatch`].
@@ -122,6 +127,8 @@ pub enum Message<'a> {
     Stop,
     /// Host: one more chip of a rig.
     AddDevice(AddDevice),
+    /// Host: one piece of the source-(b) sampling chain.
+    AddVibration(AddVibration),
     /// Host: finished register images.
     Images(ImageBatch<'a>),
     /// Host: true kinematics for the on-device model.
@@ -151,6 +158,7 @@ impl<'a> Message<'a> {
             Self::Start(_) => Kind::Start,
             Self::Stop => Kind::Stop,
             Self::AddDevice(_) => Kind::AddDevice,
+            Self::AddVibration(_) => Kind::AddVibration,
             Self::Images(_) => Kind::Images,
             Self::Kinematics(_) => Kind::Kinematics,
             Self::HelloAck(_) => Kind::HelloAck,
@@ -178,6 +186,7 @@ impl<'a> Message<'a> {
             Kind::Start => Self::Start(Start::parse(&mut r)?),
             Kind::Stop => Self::Stop,
             Kind::AddDevice => Self::AddDevice(AddDevice::parse(&mut r)?),
+            Kind::AddVibration => Self::AddVibration(AddVibration::parse(&mut r)?),
             Kind::Images => Self::Images(ImageBatch::parse(&mut r)?),
             Kind::Kinematics => Self::Kinematics(KinematicsBatch::parse(&mut r)?),
             Kind::HelloAck => Self::HelloAck(HelloAck::parse(&mut r)?),
@@ -200,6 +209,7 @@ impl<'a> Message<'a> {
             Self::Start(_) => Start::LEN,
             Self::Stop => 0,
             Self::AddDevice(m) => m.buffer_len(),
+            Self::AddVibration(m) => m.buffer_len(),
             Self::Images(m) => m.buffer_len(),
             Self::Kinematics(m) => m.buffer_len(),
             Self::HelloAck(_) => HelloAck::LEN,
@@ -222,6 +232,7 @@ impl<'a> Message<'a> {
             Self::Start(m) => m.emit(&mut w),
             Self::Stop => Ok(()),
             Self::AddDevice(m) => m.emit(&mut w),
+            Self::AddVibration(m) => m.emit(&mut w),
             Self::Images(m) => m.emit(&mut w),
             Self::Kinematics(m) => m.emit(&mut w),
             Self::HelloAck(m) => m.emit(&mut w),

@@ -297,9 +297,12 @@ code_enum! {
         MalformedMessage = 3,
         /// [`Configure`](super::Configure) names a chip the device cannot emulate.
         UnsupportedChip = 4,
-        /// [`Configure`](super::Configure) asks for a source the device does not support.
+        /// [`Configure`](super::Configure) asks for a source the device does not support
+        /// (`detail` 1: a perturbation), or an [`AddVibration`](super::AddVibration) came in
+        /// source (a) (`detail` 2).
         UnsupportedMode = 5,
-        /// The configuration was refused (the model rejected a term; `detail` may say which).
+        /// The configuration was refused (the model rejected a term; `detail` may say which: 2
+        /// while running, 7 an [`AddVibration`](super::AddVibration) the device cannot hold).
         InvalidConfig = 6,
         /// [`Start`] or samples before a valid [`Configure`](super::Configure).
         NotConfigured = 7,
