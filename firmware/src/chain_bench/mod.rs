@@ -9,7 +9,7 @@
 //! (the output path or the internal path, without vibration, with motor tones, with tones and
 //! a shock, with random vibration). [`run`] builds the case's
 //! [`DeviceChain`](margemu_model::chain::DeviceChain) and a
-//! [`Marg`](margemu_model::sensor::Marg) with white noise from fixed-size values and the
+//! [`Marg`] with white noise from fixed-size values and the
 //! caller's random-vibration buffer (no allocation), runs [`Case::output_samples`] output
 //! samples (half a second) of a deterministic synthetic truth (a slow rotation through gravity),
 //! and folds the bits of every output sample (`f32::to_bits` of the accelerometer's then the

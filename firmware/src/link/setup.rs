@@ -127,9 +127,10 @@ impl ModelFront {
 /// The front end of a chip with `settings` at the output `rate`, seeded with `seed`, as `setup`
 /// says (`None` for a magnetometer-only chip: vibration does not reach it): the [`Clipper`]
 /// when nothing vibrates on the output path, else the chain. Built exactly as the host's
-/// `margemu_sim::sampling::build`: the output path at the output period rounded to
-/// ns, or the chip's declared chain ([`ChipChain::new`]) at its internal periods; each sensor's
-/// vibration adds the tone sources then the shocks, in order.
+/// `margemu_sim::sampling::build`: the output path at the output period rounded to ns, or the
+/// chip's declared chain ([`ChipChain::new`](margemu_protocol::chip::chain::ChipChain::new)) at
+/// its internal periods; each sensor's vibration adds the tone sources then the shocks, in
+/// order.
 pub fn model_chain(
     settings: &ChipSettings,
     rate: Rate,
