@@ -374,6 +374,17 @@ fn settings_bytes_round_trip() {
     }
     assert_eq!(ChainConfig::decode(&[]), Err(ChainError::Malformed));
     assert_eq!(ChainConfig::decode(&[9, 1, 2]), Err(ChainError::Malformed));
+    // A flag is 0 or 1 on the link (found by the message fuzzer: 0x70 decoded as true and
+    // re-encoded as 1).
+    assert_eq!(
+        ChainConfig::decode(&[0, 5, 0, 0, 0x70]),
+        Err(ChainError::Malformed)
+    );
+    assert!(ChainConfig::decode(&[0, 5, 0, 0, 1]).is_ok());
+    assert_eq!(
+        ChainConfig::decode(&[2, 2, 2, 1, 2]),
+        Err(ChainError::Malformed)
+    );
     assert_eq!(
         ChainConfig::decode(&[3, 1, 0xA]),
         Ok(ChainConfig::Bmi088 {

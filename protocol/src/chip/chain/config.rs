@@ -270,6 +270,12 @@ impl ChainConfig {
             3 => Family::Bmi088,
             _ => return Err(ChainError::Malformed),
         };
-        Self::from_values(family, values).ok_or(ChainError::Malformed)
+        let config = Self::from_values(family, values).ok_or(ChainError::Malformed)?;
+        // The link carries a flag as 0 or 1 only: one encoding per setting, so what decodes
+        // encodes back to the same bytes.
+        if config.values().as_slice() != values {
+            return Err(ChainError::Malformed);
+        }
+        Ok(config)
     }
 }
