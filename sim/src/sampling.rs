@@ -18,7 +18,7 @@
 use crate::scene::chip::ChipSetup;
 use crate::scene::vibration::{DeviceVibration, SamplingPath};
 use crate::scene::Scene;
-use margemu_model::chain::{Clipper, DeviceChain, Front, SensorPath};
+use margemu_model::chain::{output_period_ns, Clipper, DeviceChain, Front, SensorPath};
 use margemu_model::perturbation::Complex;
 use margemu_model::vibration::{RpmPoint, Sense, Vibration};
 use margemu_model::Error;
@@ -70,7 +70,8 @@ pub fn build(
     if vibration.is_empty() && !internal {
         return Some(Clipper::new(accel_range, gyro_range).map(Front::Clip));
     }
-    Some(chain(scene, chip, vibration, seed, internal).map(Front::Chain))
+    let ranges = [accel_range, gyro_range];
+    Some(chain(scene, chip, vibration, seed, internal, ranges).map(Front::Chain))
 }
 
 fn chain(
@@ -79,12 +80,10 @@ fn chain(
     vibration: &DeviceVibration,
     seed: u64,
     internal: bool,
+    [accel_range, gyro_range]: [f32; 2],
 ) -> Result<HostChain, Error> {
-    let Some([accel_range, gyro_range]) = chip.settings.front_end_ranges() else {
-        return Err(Error::ChainRefused);
-    };
     if !internal {
-        let period = libm_round(1e9 / scene.clock.hz());
+        let period = output_period_ns(scene.clock.hz());
         let path = |sense, range| -> Result<HostPath, Error> {
             SensorPath::at_output(range, sensor_vibration(sense, period, seed, vibration)?)
         };
@@ -104,10 +103,6 @@ fn chain(
     })
 }
 
-fn libm_round(x: f64) -> u64 {
-    x.round().max(1.0) as u64
-}
-
 /// The vibration one sensor sees, sampled every `period_ns`.
 pub fn sensor_vibration(
     sense: Sense,
@@ -115,13 +110,8 @@ pub fn sensor_vibration(
     seed: u64,
     vibration: &DeviceVibration,
 ) -> Result<HostVibration, Error> {
-    let mut vib = Vibration::new(sense, period_ns, seed);
-    for tones in &vibration.tones {
-        vib.add_tones(tones.clone())?;
-    }
-    for shock in &vibration.shocks {
-        vib.add_shock(shock)?;
-    }
+    let mut vib =
+        Vibration::with_sources(sense, period_ns, seed, &vibration.tones, &vibration.shocks)?;
     if let (Sense::Linear, Some(random)) = (sense, &vibration.random) {
         let len = random.buffer_len(1e9 / period_ns as f64)?;
         vib.add_random(random, vec![Complex::ZERO; len])?;

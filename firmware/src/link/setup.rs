@@ -171,19 +171,12 @@ fn vibration_chain(
     use margemu_model::chain::SensorPath;
     use margemu_model::vibration::{Sense, Vibration};
     use margemu_protocol::chip::chain::{ChipChain, SensorChain};
-    let vibration = |sense, period_ns| -> Result<_, margemu_model::Error> {
-        let mut vib = Vibration::new(sense, period_ns, seed);
-        for tones in &setup.tones {
-            vib.add_tones(tones.clone())?;
-        }
-        for shock in &setup.shocks {
-            vib.add_shock(shock)?;
-        }
-        Ok(vib)
+    let vibration = |sense, period_ns| {
+        Vibration::with_sources(sense, period_ns, seed, &setup.tones, &setup.shocks)
     };
     match &setup.internal {
         None => {
-            let period = libm::round(1e9 / rate.as_hz_f64()).max(1.0) as u64;
+            let period = margemu_model::chain::output_period_ns(rate.as_hz_f64());
             let path = |sense, range| SensorPath::at_output(range, vibration(sense, period)?);
             Ok(Front::Chain(DeviceChain {
                 accel: path(Sense::Linear, accel)?,

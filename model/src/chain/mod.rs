@@ -46,6 +46,12 @@ use crate::vec3::{clamp, Vec3};
 use crate::vibration::{RpmPoint, Vibration};
 use filter::{FilterDesign, FilterState};
 
+/// The period the output path's vibration steps by at `rate_hz`, ns: `1e9 / rate` rounded, at
+/// least 1 (the tones' phases advance by it once per output sample).
+pub fn output_period_ns(rate_hz: f64) -> u64 {
+    libm::round(1e9 / rate_hz).max(1.0) as u64
+}
+
 /// One sensor's chain at its internal rate (or at the output instants).
 pub struct SensorPath<P, B> {
     /// 0 on the output path.

@@ -104,6 +104,29 @@ impl<P: AsRef<[RpmPoint]>, B: AsMut<[Complex]> + AsRef<[Complex]>> Vibration<P, 
         }
     }
 
+    /// The vibration of `sense` at `period_ns` with `seed`: every tone source, then every
+    /// shock, in their order (the one order host and device build it in, so both give the same
+    /// bits).
+    pub fn with_sources<'a>(
+        sense: Sense,
+        period_ns: u64,
+        seed: u64,
+        tones: impl IntoIterator<Item = &'a ToneSource<P>>,
+        shocks: impl IntoIterator<Item = &'a Shock>,
+    ) -> Result<Self, Error>
+    where
+        P: Clone + 'a,
+    {
+        let mut vib = Self::new(sense, period_ns, seed);
+        for t in tones {
+            vib.add_tones(t.clone())?;
+        }
+        for shock in shocks {
+            vib.add_shock(shock)?;
+        }
+        Ok(vib)
+    }
+
     /// Adds a tone source (its amplitudes of this sensor's sense; a source without any is
     /// checked and left out, costing nothing); refuses a [`MAX_TONE_SOURCES`]-th + 1 or an
     /// invalid profile.
