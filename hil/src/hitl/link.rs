@@ -15,7 +15,8 @@ use std::io::{self, Read, Write};
 use std::net::{SocketAddr, ToSocketAddrs, UdpSocket};
 use std::time::Duration;
 
-/// Bytes on the wire of one HIL_SENSOR in MAVLink 2 (10 header, 64 payload, 2 CRC).
+/// Bytes on the wire of one HIL_SENSOR in MAVLink 2, at most (10 header, 64 payload, 2 CRC;
+/// MAVLink 2 drops the payload's trailing zero bytes: 74 with [`super::message::FIELDS_SENT`]).
 pub const HIL_SENSOR_FRAME_BYTES: u64 = 76;
 /// Bytes of one HEARTBEAT in MAVLink 2 (10 header, 9 payload, 2 CRC).
 pub const HEARTBEAT_FRAME_BYTES: u64 = 21;
