@@ -115,6 +115,8 @@ pub enum HitlError {
     BadScale(f64),
     /// the scene's rate, {0} Hz, is above 1 MHz: HIL_SENSOR's time_usec cannot tell its samples apart
     RateTooHigh(f64),
+    /// the scene's rate cannot be sent: {0}
+    Rate(String),
     /// {0}
     Run(#[from] RunError),
     /// cannot write {path}

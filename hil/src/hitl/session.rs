@@ -26,7 +26,7 @@ use margemu_sim::marg::MargSim;
 use margemu_sim::output::{TruthWriter, TRUTH_FILE};
 use margemu_sim::run::RunError;
 use margemu_sim::rundir::{CompletionRecord, Status};
-use margemu_sim::scene::{FieldUnit, Scene};
+use margemu_sim::scene::Scene;
 use margemu_sim::truth::Truth;
 use mavlink::dialects::common::{MavMessage, HIL_SENSOR_DATA};
 use std::fs::File;
@@ -106,10 +106,7 @@ impl<'a> HitlSession<'a> {
             super::link::check_line(scene.clock.hz(), *baud)?;
         }
         MargSim::new(scene).map_err(RunError::Model)?;
-        let rate = rate_of(scene).map_err(|e| HitlError::Write {
-            path: dir.join(margemu_sim::rundir::META_FILE),
-            source: io::Error::other(e.to_string()),
-        })?;
+        let rate = rate_of(scene).map_err(|e| HitlError::Rate(e.to_string()))?;
         let mapping = SensorMapping {
             gauss_per_unit: gauss_per_unit(scene.spec.field.unit, g),
             temperature: scene.spec.sensors.temperature,
@@ -126,9 +123,6 @@ impl<'a> HitlSession<'a> {
         meta.batch = 1;
         meta.telemetry_period_ns = 0;
         meta.mag_ut_per_unit = mapping.gauss_per_unit / GAUSS_PER_MICROTESLA;
-        if scene.spec.field.unit == FieldUnit::Microtesla {
-            meta.mag_ut_per_unit = 1.0;
-        }
         let meta_path = dir.join(margemu_sim::rundir::META_FILE);
         std::fs::create_dir_all(dir)
             .and_then(|()| margemu_sim::meta::write(dir, &meta))
