@@ -91,6 +91,22 @@ fn a_port_that_is_not_there_is_named() {
         "{e}"
     );
     assert!(!o.exists(), "nothing is written before the link is open");
+    // A scene in normalized units is sent at --gauss-per-unit, with a warning.
+    let out = margemu(&[
+        "hitl",
+        "figure3",
+        "--port",
+        "/dev/margemu-no-such-port",
+        "--gauss-per-unit",
+        "0.45",
+    ]);
+    let e = stderr(&out);
+    assert!(
+        e.contains(
+            "warning: the scene's field is in normalized units; sent as 0.45 gauss per unit"
+        ),
+        "{e}"
+    );
 }
 
 #[test]
