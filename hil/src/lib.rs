@@ -11,12 +11,15 @@
 //!   default);
 //! - [`dut`]: the device under test's attitude output (MAVLink or MSP) read from a second port
 //!   and logged;
+//! - [`hitl`]: a scene sent as MAVLink HIL_SENSOR to a flight controller in HITL mode, its
+//!   attitude read back;
 //! - [`vfc`]: a virtual flight controller on the loopback device (the chip's third-party
 //!   driver, a reference filter, MAVLink out).
 #![warn(missing_docs)]
 
 pub mod bus;
 pub mod dut;
+pub mod hitl;
 pub mod loopback;
 pub mod stream;
 pub mod vfc;

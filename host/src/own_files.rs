@@ -9,6 +9,7 @@ pub const OWN_FILES: OwnFiles = &[
     &margemu_sim::output::RUN_FILES,
     &margemu_hil::stream::log::SESSION_FILES,
     &margemu_hil::dut::log::FILES,
+    &margemu_hil::hitl::session::HITL_FILES,
     &margemu_eval::evaluate::report::FILES,
     &[crate::demo::table::FILE],
 ];

@@ -13,7 +13,7 @@ use margemu_sim::scene::chip::{BusKind, ChipSetup};
 use margemu_sim::scene::Scene;
 
 /// `meta.toml`; `hold` is the kinematics hold of source mode model (`None`: images).
-pub(super) fn metadata(
+pub(crate) fn metadata(
     scene: &Scene,
     c: &StreamConfig,
     s: &ImageSettings,

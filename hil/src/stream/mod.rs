@@ -85,7 +85,7 @@ pub mod images;
 mod lateness;
 pub mod log;
 mod logger;
-mod meta;
+pub(crate) mod meta;
 pub mod model;
 mod pacing;
 mod plan;

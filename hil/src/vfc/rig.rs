@@ -158,16 +158,29 @@ pub fn attach(
 ) -> Result<AttachedDut, DutError> {
     let origin = Instant::now();
     session.set_origin(origin);
-    let reader = DutReader::spawn(port, config, dir, origin)?;
-    Ok(AttachedDut {
-        reader,
-        origin,
-        dir: dir.to_path_buf(),
-        completion: session.completion_record(),
-    })
+    AttachedDut::start(port, config, dir, origin, session.completion_record())
 }
 
 impl AttachedDut {
+    /// Starts a reader of `config` on `port`, logging into `dir` (which must exist) with host
+    /// times since `origin`; `completion` is the directory's shared completion record, if any,
+    /// released by [`Self::finish`].
+    pub fn start(
+        port: impl Read + Write + Send + 'static,
+        config: DutConfig,
+        dir: &Path,
+        origin: Instant,
+        completion: Option<CompletionRecord>,
+    ) -> Result<Self, DutError> {
+        let reader = DutReader::spawn(port, config, dir, origin)?;
+        Ok(Self {
+            reader,
+            origin,
+            dir: dir.to_path_buf(),
+            completion,
+        })
+    }
+
     /// What the reader has seen so far.
     pub fn progress(&self) -> DutProgress {
         self.reader.progress()

@@ -12,6 +12,7 @@ pub mod chips;
 pub mod demo;
 pub mod evaluate;
 pub mod filter;
+pub mod hitl;
 pub mod loopback;
 pub mod ports;
 pub mod scene;
@@ -127,6 +128,10 @@ pub enum Command {
     /// Stream a scene to a device in real time over a serial port and log the session to
     /// sessions/<scene name> (numbered if taken) unless -o.
     Stream(stream::Cmd),
+    /// Send a scene as MAVLink HIL_SENSOR to a flight controller in HITL mode (PX4) over a
+    /// serial port or UDP, log the attitude it sends back, and write the session to
+    /// sessions/<scene name>-hitl (numbered if taken) unless -o.
+    Hitl(hitl::Cmd),
     /// List serial ports.
     Ports(ports::Cmd),
     /// List the emulated chips: identities, buses, full scales, rates, what is emulated.
@@ -181,6 +186,7 @@ impl Command {
             Command::Bench(c) => c.run(),
             Command::Analyze(c) => c.run(),
             Command::Stream(c) => c.run(),
+            Command::Hitl(c) => c.run(),
             Command::Ports(c) => c.run(),
             Command::Chips(c) => c.run(),
             Command::Evaluate(c) => c.run(),
