@@ -25,6 +25,7 @@
 
 use super::clipping::{ClippingWriter, Clips};
 use super::device_truth::DeviceTruthWriter;
+use super::mcap_log::SessionMcap;
 use margemu_model::sensor;
 use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
 use margemu_sim::meta::{Appended, SessionMeta};
@@ -147,6 +148,8 @@ pub struct SessionLog {
     device_truth: Option<DeviceTruthWriter>,
     /// `clipping.csv`.
     clipping: ClippingWriter,
+    /// `session.mcap`, when asked for.
+    mcap: Option<SessionMcap>,
 }
 
 fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
@@ -193,9 +196,23 @@ impl SessionLog {
                 dir,
                 &devices.iter().map(|d| d.name.clone()).collect::<Vec<_>>(),
             )?,
+            mcap: None,
         };
         log.flush()?;
         Ok(log)
+    }
+
+    /// Also writes `session.mcap` from now on.
+    pub(super) fn with_mcap(mut self, mcap: SessionMcap) -> Self {
+        self.mcap = Some(mcap);
+        self
+    }
+
+    /// Start was sent at `host_ns` (`session.mcap`'s events are at scene time from now on).
+    pub(super) fn started(&mut self, host_ns: i64) {
+        if let Some(m) = &mut self.mcap {
+            m.started(host_ns);
+        }
     }
 
     /// The session directory.
@@ -211,6 +228,9 @@ impl SessionLog {
     /// Rows of `truth.csv` (and a rig's `device_truth.csv`), in order.
     pub fn truth(&mut self, truths: &[Truth]) -> io::Result<()> {
         truths.iter().try_for_each(|t| self.truth.write(t))?;
+        if let Some(m) = &mut self.mcap {
+            m.truth(truths)?;
+        }
         match &mut self.device_truth {
             Some(d) => d.write(truths),
             None => Ok(()),
@@ -246,6 +266,9 @@ impl SessionLog {
         }
         if self.image_split.is_empty() {
             write!(self.sent, ",{image:x}")?;
+        }
+        if let (Some(m), false) = (&mut self.mcap, resend) {
+            m.image(t_ns, image)?;
         }
         writeln!(self.sent, ",{}", u8::from(resend))
     }
@@ -374,6 +397,9 @@ impl SessionLog {
 
     /// One row of `events.csv` (commas in `detail` become semicolons).
     pub fn event(&mut self, host_ns: i64, event: &str, detail: &str) -> io::Result<()> {
+        if let Some(m) = &mut self.mcap {
+            m.event(host_ns, event, detail)?;
+        }
         writeln!(
             self.events,
             "{host_ns},{event},{}",
@@ -381,9 +407,13 @@ impl SessionLog {
         )
     }
 
-    /// Writes what closes a file (the clipping totals) and flushes every file.
+    /// Writes what closes a file (the clipping totals, `session.mcap`'s summary) and flushes
+    /// every file.
     pub fn close(&mut self) -> io::Result<()> {
         self.clipping.finish()?;
+        if let Some(m) = self.mcap.take() {
+            m.finish()?;
+        }
         self.flush()
     }
 
@@ -398,6 +428,9 @@ impl SessionLog {
         self.truth.flush()?;
         if let Some(d) = &mut self.device_truth {
             d.flush()?;
+        }
+        if let Some(m) = &mut self.mcap {
+            m.flush()?;
         }
         self.events.flush()
     }

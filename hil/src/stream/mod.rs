@@ -85,6 +85,7 @@ pub mod images;
 mod lateness;
 pub mod log;
 mod logger;
+mod mcap_log;
 mod meta;
 pub mod model;
 mod pacing;
