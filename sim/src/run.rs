@@ -255,7 +255,6 @@ fn mcap_setup(scene: &Scene) -> McapSetup {
         field_unit: scene.spec.field.unit,
         ut_per_unit: mcap::ut_per_unit(scene.spec.field.unit),
         devices: vec![(scene.chip_name.clone(), mcap::PLATE_FRAME.to_string())],
-        dut: false,
         clock: "scene time (ns since the scene start)".to_string(),
     }
 }

@@ -215,6 +215,14 @@ impl SessionLog {
         }
     }
 
+    /// The device under test's attitude, received at `host_ns` (`session.mcap` only).
+    pub(super) fn dut_attitude(&mut self, host_ns: i64, q: [f64; 4]) -> io::Result<()> {
+        match &mut self.mcap {
+            Some(m) => m.dut_attitude(host_ns, q),
+            None => Ok(()),
+        }
+    }
+
     /// The session directory.
     pub fn dir(&self) -> &Path {
         &self.dir

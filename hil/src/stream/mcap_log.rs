@@ -11,6 +11,10 @@
 //!   (frame: the device's name), at the sample's latch instant. The device serves these very
 //!   images, each at its instant (`served.csv` checks their CRCs). In source mode model the
 //!   device computes its own samples: no device channels.
+//! - `/dut/attitude` and `/tf` world→dut: each attitude row of the device under test's reader
+//!   (`dut_attitude.csv`), given to the log writer through a [`LogSink`](super::LogSink), at its
+//!   host reception time minus `start_host_ns`, while the session's logs are open (the rows
+//!   after its end are in `dut_attitude.csv` only).
 //! - `/events`: every row of `events.csv`, at its host time minus `start_host_ns` (scene time;
 //!   0 for the events before Start).
 //!
@@ -68,7 +72,6 @@ impl SessionMcap {
             field_unit: scene.spec.field.unit,
             ut_per_unit,
             devices: names,
-            dut: false,
             clock:
                 "scene time (ns): samples at their latch instant, events at host_ns - start_host_ns"
                     .to_string(),
@@ -117,6 +120,12 @@ impl SessionMcap {
     pub(super) fn event(&mut self, host_ns: i64, event: &str, detail: &str) -> io::Result<()> {
         let t_ns = scene_time(host_ns, self.start_host_ns);
         self.log.event(t_ns, event, detail)
+    }
+
+    /// The device under test's attitude `q`, received at host time `host_ns`.
+    pub(super) fn dut_attitude(&mut self, host_ns: i64, q: [f64; 4]) -> io::Result<()> {
+        let t_ns = scene_time(host_ns, self.start_host_ns);
+        self.log.dut_attitude(t_ns, &q)
     }
 
     /// Ends the open chunk and flushes the file.

@@ -103,6 +103,7 @@ pub mod window;
 
 pub use images::{predict_images, ImageSettings, PredictedSample};
 pub use lateness::Lateness;
+pub use logger::LogSink;
 pub use model::{
     device_chip, kinematics_hold, model_images, predict_model, ModelPrediction, ModelSample,
 };

@@ -189,6 +189,12 @@ impl Session {
         self.origin = Some(origin);
     }
 
+    /// A handle the device under test's reader writes its attitude into `session.mcap` with;
+    /// `None` unless the session writes one ([`StreamConfig::mcap`]).
+    pub fn log_sink(&mut self) -> Option<super::LogSink> {
+        self.config.mcap.then(|| self.log.sink())
+    }
+
     /// A share of the session directory's completion record ([`margemu_sim::rundir`]), for a writer
     /// that logs into the directory beside the session (the device under test's reader): the
     /// record is written to `meta.toml` when the session has ended and every share is let go.

@@ -158,6 +158,10 @@ pub fn attach(
 ) -> Result<AttachedDut, DutError> {
     let origin = Instant::now();
     session.set_origin(origin);
+    let config = DutConfig {
+        session_log: session.log_sink(),
+        ..config
+    };
     let reader = DutReader::spawn(port, config, dir, origin)?;
     Ok(AttachedDut {
         reader,

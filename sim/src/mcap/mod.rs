@@ -111,8 +111,6 @@ pub struct McapSetup {
     pub ut_per_unit: f64,
     /// The devices whose MARG samples are written: name and frame id of its axes.
     pub devices: Vec<(String, String)>,
-    /// A device under test's attitude is written.
-    pub dut: bool,
     /// Which clock the times are on (the metadata's `time`).
     pub clock: String,
 }
@@ -130,6 +128,16 @@ pub struct MargReading {
     pub mag_ut: Option<[f64; 3]>,
 }
 
+/// The ids of the channels of [`FIXED_TOPICS`].
+#[derive(Default)]
+struct Channels {
+    pose: u16,
+    twist: u16,
+    imu: u16,
+    tf: u16,
+    events: u16,
+}
+
 struct DeviceChannels {
     imu: u16,
     mag: u16,
@@ -139,11 +147,10 @@ struct DeviceChannels {
 /// An MCAP file being written.
 pub struct McapLog<W: Write + Seek = BufWriter<File>> {
     out: mcap::Writer<W>,
-    pose: u16,
-    twist: u16,
-    imu: u16,
-    tf: u16,
-    events: u16,
+    /// Schema ids by type name.
+    schemas: BTreeMap<&'static str, u16>,
+    channels: Channels,
+    /// `/dut/attitude`, added with its first message.
     dut: Option<u16>,
     devices: Vec<DeviceChannels>,
     /// Messages written per channel id (the next sequence number).
@@ -171,40 +178,32 @@ impl McapLog {
 impl<W: Write + Seek> McapLog<W> {
     /// Starts a file in `out`: header, schemas, channels and metadata.
     pub fn new(out: W, setup: &McapSetup) -> io::Result<Self> {
-        let mut out = mcap::WriteOptions::new()
+        let out = mcap::WriteOptions::new()
             .compression(None)
             .profile("ros2")
             .library(concat!("margemu ", env!("CARGO_PKG_VERSION")))
             .create(out)
             .map_err(mcap_err)?;
-        let mut schemas = BTreeMap::new();
+        let mut log = Self {
+            out,
+            schemas: BTreeMap::new(),
+            channels: Channels::default(),
+            dut: None,
+            devices: Vec::new(),
+            sequence: Vec::new(),
+            pending: false,
+            buf: Vec::with_capacity(512),
+        };
         let none = BTreeMap::new();
-        let tesla = (setup.ut_per_unit / 1e6).to_string();
-        let mut channel = |topic: &str, t: &MsgType, meta: &BTreeMap<String, String>| {
-            let schema = match schemas.get(t.name) {
-                Some(id) => *id,
-                None => {
-                    let text = t.schema_text();
-                    let id = out
-                        .add_schema(t.name, "ros2msg", text.as_bytes())
-                        .map_err(mcap_err)?;
-                    schemas.insert(t.name, id);
-                    id
-                }
-            };
-            out.add_channel(schema, topic, "cdr", meta)
-                .map_err(mcap_err)
-        };
         let [pose, twist, imu, tf, events] = FIXED_TOPICS;
-        let pose = channel(pose, &schema::POSE_STAMPED, &none)?;
-        let twist = channel(twist, &schema::TWIST_STAMPED, &none)?;
-        let imu = channel(imu, &schema::IMU, &none)?;
-        let tf = channel(tf, &schema::TF_MESSAGE, &none)?;
-        let events = channel(events, &schema::STRING, &none)?;
-        let dut = match setup.dut {
-            true => Some(channel(DUT_TOPIC, &schema::POSE_STAMPED, &none)?),
-            false => None,
+        log.channels = Channels {
+            pose: log.channel(pose, &schema::POSE_STAMPED, &none)?,
+            twist: log.channel(twist, &schema::TWIST_STAMPED, &none)?,
+            imu: log.channel(imu, &schema::IMU, &none)?,
+            tf: log.channel(tf, &schema::TF_MESSAGE, &none)?,
+            events: log.channel(events, &schema::STRING, &none)?,
         };
+        let tesla = (setup.ut_per_unit / 1e6).to_string();
         let mag_meta = BTreeMap::from([
             (
                 "scene_field_unit".to_string(),
@@ -212,18 +211,18 @@ impl<W: Write + Seek> McapLog<W> {
             ),
             ("tesla_per_unit".to_string(), tesla.clone()),
         ]);
-        let mut devices = Vec::new();
         for (name, frame) in &setup.devices {
             let prefix = topic_name(name);
-            devices.push(DeviceChannels {
-                imu: channel(&format!("/{prefix}/imu"), &schema::IMU, &none)?,
-                mag: channel(
+            let d = DeviceChannels {
+                imu: log.channel(&format!("/{prefix}/imu"), &schema::IMU, &none)?,
+                mag: log.channel(
                     &format!("/{prefix}/mag"),
                     &schema::MAGNETIC_FIELD,
                     &mag_meta,
                 )?,
                 frame: frame.clone(),
-            });
+            };
+            log.devices.push(d);
         }
         let metadata = BTreeMap::from([
             ("scene".to_string(), setup.scene.clone()),
@@ -236,25 +235,40 @@ impl<W: Write + Seek> McapLog<W> {
             ("tesla_per_unit".to_string(), tesla),
             ("time".to_string(), setup.clock.clone()),
         ]);
-        out.write_metadata(&mcap::records::Metadata {
-            name: "margemu".to_string(),
-            metadata,
-        })
-        .map_err(mcap_err)?;
-        let channels = 6 + usize::from(setup.dut) + 2 * devices.len();
-        Ok(Self {
-            out,
-            pose,
-            twist,
-            imu,
-            tf,
-            events,
-            dut,
-            devices,
-            sequence: vec![0; channels + 1],
-            pending: false,
-            buf: Vec::with_capacity(512),
-        })
+        log.out
+            .write_metadata(&mcap::records::Metadata {
+                name: "margemu".to_string(),
+                metadata,
+            })
+            .map_err(mcap_err)?;
+        Ok(log)
+    }
+
+    /// A new channel on `topic` of type `t` (its schema written once).
+    fn channel(
+        &mut self,
+        topic: &str,
+        t: &MsgType,
+        meta: &BTreeMap<String, String>,
+    ) -> io::Result<u16> {
+        let schema = match self.schemas.get(t.name) {
+            Some(id) => *id,
+            None => {
+                let text = t.schema_text();
+                let id = self
+                    .out
+                    .add_schema(t.name, "ros2msg", text.as_bytes())
+                    .map_err(mcap_err)?;
+                self.schemas.insert(t.name, id);
+                id
+            }
+        };
+        let id = self
+            .out
+            .add_channel(schema, topic, "cdr", meta)
+            .map_err(mcap_err)?;
+        self.sequence.resize(usize::from(id) + 1, 0);
+        Ok(id)
     }
 
     fn put(&mut self, channel: u16, t_ns: u64) -> io::Result<()> {
@@ -279,13 +293,13 @@ impl<W: Write + Seek> McapLog<W> {
             .header(t.t_ns, WORLD_FRAME)
             .f64s(&t.position)
             .f64s(&q);
-        self.put(self.pose, t.t_ns)?;
+        self.put(self.channels.pose, t.t_ns)?;
         let v_body = body_vector(&t.quaternion, &t.velocity);
         Cdr::new(&mut self.buf)
             .header(t.t_ns, PLATE_FRAME)
             .f64s(&v_body)
             .f64s(&t.body_rate);
-        self.put(self.twist, t.t_ns)?;
+        self.put(self.channels.twist, t.t_ns)?;
         Cdr::new(&mut self.buf)
             .header(t.t_ns, PLATE_FRAME)
             .f64s(&q)
@@ -294,7 +308,7 @@ impl<W: Write + Seek> McapLog<W> {
             .f64s(&[0.0; 9])
             .f64s(&t.specific_force)
             .f64s(&[0.0; 9]);
-        self.put(self.imu, t.t_ns)?;
+        self.put(self.channels.imu, t.t_ns)?;
         self.transform(t.t_ns, PLATE_FRAME, &t.position, &q)
     }
 
@@ -305,7 +319,7 @@ impl<W: Write + Seek> McapLog<W> {
             .string(child)
             .f64s(p)
             .f64s(q);
-        self.put(self.tf, t_ns)
+        self.put(self.channels.tf, t_ns)
     }
 
     /// One MARG sample of device `device` (its index in [`McapSetup::devices`]):
@@ -339,12 +353,14 @@ impl<W: Write + Seek> McapLog<W> {
     }
 
     /// The device under test's attitude `q` (`(w, x, y, z)`, body to world) at `t_ns`:
-    /// `/dut/attitude` and `/tf` world→dut. An error if the file has no `/dut/attitude`.
+    /// `/dut/attitude` (its channel added with the first) and `/tf` world→dut.
     pub fn dut_attitude(&mut self, t_ns: u64, q: &[f64; 4]) -> io::Result<()> {
-        let Some(dut) = self.dut else {
-            return Err(io::Error::other(
-                "the MCAP file has no /dut/attitude channel",
-            ));
+        let dut = match self.dut {
+            Some(id) => id,
+            None => {
+                let id = self.channel(DUT_TOPIC, &schema::POSE_STAMPED, &BTreeMap::new())?;
+                *self.dut.insert(id)
+            }
         };
         let q = ros_quaternion(q);
         Cdr::new(&mut self.buf)
@@ -362,7 +378,7 @@ impl<W: Write + Seek> McapLog<W> {
             d => format!("{event}: {d}"),
         };
         Cdr::new(&mut self.buf).string(&text);
-        self.put(self.events, t_ns)
+        self.put(self.channels.events, t_ns)
     }
 
     /// Ends the open chunk (if a message was written since the last) and flushes the file, so
