@@ -28,4 +28,5 @@ pub mod demo;
 pub mod own_files;
 pub mod perf;
 pub mod perf_chain;
+pub mod perf_mcap;
 pub mod vfc_score;

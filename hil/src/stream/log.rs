@@ -19,6 +19,9 @@
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before,device`: each write of the device under test (`bus` spi, i2c or aux; `address`: the I2C address, or on SPI the chip select of the device written, 0 for device 0; `dropped_before`: writes the device lost just before this batch; `device`: the name of the scene's device it reached, empty if none answers that address) |
 //! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `resend_out_of_window` (a hole older than the items the session keeps: not resent), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
 //!
+//! With [`StreamConfig::mcap`](super::StreamConfig::mcap), `session.mcap` is written beside
+//! them, by the same writer, from the same rows (`super::mcap_log`).
+//!
 //! `meta.toml` ends with the `[completion]` table (status, samples written, why the session
 //! ended; [`margemu_sim::rundir`]), written once every file is closed: after the session, or after
 //! the device under test's reader when one is attached.

@@ -47,6 +47,8 @@ use std::path::Path;
 pub const RUN_MCAP: &str = "run.mcap";
 /// A session's MCAP file.
 pub const SESSION_MCAP: &str = "session.mcap";
+/// The MCAP files margemu writes (what `--force` may remove).
+pub const FILES: [&str; 2] = [RUN_MCAP, SESSION_MCAP];
 /// The world frame's id.
 pub const WORLD_FRAME: &str = "world";
 /// The plate's frame id.
