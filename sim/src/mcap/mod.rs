@@ -411,3 +411,122 @@ fn body_vector(q: &[f64; 4], v: &[f64; 3]) -> [f64; 3] {
     let b = q.inverse_transform_vector(&nalgebra::Vector3::from(*v));
     [b.x, b.y, b.z]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::RefCell;
+    use std::io::{Cursor, SeekFrom};
+    use std::rc::Rc;
+
+    /// A file in memory that the test can read while the writer still holds it.
+    #[derive(Clone, Default)]
+    struct Shared(Rc<RefCell<Cursor<Vec<u8>>>>);
+
+    impl Write for Shared {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            self.0.borrow_mut().write(buf)
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    impl Seek for Shared {
+        fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
+            self.0.borrow_mut().seek(pos)
+        }
+    }
+
+    fn setup() -> McapSetup {
+        McapSetup {
+            scene: "s".into(),
+            seed: 1,
+            field_unit: FieldUnit::Normalized,
+            ut_per_unit: UT_PER_NU,
+            devices: vec![("MPU-9250".into(), PLATE_FRAME.into())],
+            clock: "scene time".into(),
+        }
+    }
+
+    fn truth(t_ns: u64) -> Truth {
+        Truth {
+            t_ns,
+            quaternion: [1.0, 0.0, 0.0, 0.0],
+            ..Truth::default()
+        }
+    }
+
+    #[test]
+    fn a_file_left_unfinished_holds_every_message_up_to_the_last_flush() {
+        let file = Shared::default();
+        let mut log = McapLog::new(file.clone(), &setup()).unwrap();
+        for k in 0..10 {
+            log.truth(&truth(k * 1_000_000)).unwrap();
+        }
+        log.flush().unwrap();
+        log.truth(&truth(10_000_000)).unwrap();
+        // The process dies here: no finish, no summary, no footer, no end magic.
+        let bytes = file.0.borrow().get_ref().clone();
+        let read = mcap::MessageStream::new_with_options(
+            &bytes,
+            mcap::read::Options::IgnoreEndMagic.into(),
+        )
+        .unwrap();
+        let times: Vec<u64> = read
+            .map_while(Result::ok)
+            .filter(|m| m.channel.topic == "/truth/pose")
+            .map(|m| m.log_time)
+            .collect();
+        assert_eq!(times, (0..10).map(|k| k * 1_000_000).collect::<Vec<_>>());
+        drop(log);
+    }
+
+    #[test]
+    fn a_finished_file_has_every_channel_and_the_dut_channel_once_used() {
+        let file = Shared::default();
+        let mut log = McapLog::new(file.clone(), &setup()).unwrap();
+        log.truth(&truth(5)).unwrap();
+        log.dut_attitude(7, &[1.0, 0.0, 0.0, 0.0]).unwrap();
+        log.event(9, "end", "").unwrap();
+        let reading = MargReading {
+            t_ns: 5,
+            acc: [0.0; 3],
+            gyr: [0.0; 3],
+            mag_ut: None,
+        };
+        log.marg(0, &reading).unwrap();
+        assert!(log.marg(1, &reading).is_err(), "no such device");
+        log.finish().unwrap();
+        let bytes = file.0.borrow().get_ref().clone();
+        let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+        let mut topics: Vec<&str> = summary.channels.values().map(|c| &*c.topic).collect();
+        topics.sort();
+        assert_eq!(
+            topics,
+            [
+                "/dut/attitude",
+                "/events",
+                "/mpu_9250/imu",
+                "/mpu_9250/mag",
+                "/tf",
+                "/truth/imu",
+                "/truth/pose",
+                "/truth/twist"
+            ]
+        );
+        let counts = &summary.stats.unwrap().channel_message_counts;
+        let count = |topic: &str| {
+            let id = summary
+                .channels
+                .values()
+                .find(|c| c.topic == topic)
+                .unwrap()
+                .id;
+            counts.get(&id).copied().unwrap_or(0)
+        };
+        // No magnetometer: an IMU message and no field.
+        assert_eq!((count("/mpu_9250/imu"), count("/mpu_9250/mag")), (1, 0));
+        assert_eq!(count("/tf"), 2);
+    }
+}
