@@ -3,7 +3,7 @@
 //! `evaluate` reads.
 //!
 //! One writer ([`McapLog`]) serves `simulate` (`run.mcap`) and the streaming sessions
-//! (`session.mcap`). Its channels (schemas: [`schema`]; encoding: [`cdr`]):
+//! (`session.mcap`). Its channels (schemas: [`schema`]; CDR encoding: `cdr`):
 //!
 //! | topic | type | frame | content |
 //! |---|---|---|---|
