@@ -20,7 +20,7 @@
 pub use margemu_eval::{analysis, evaluate, offline, tune};
 pub use margemu_hil::{bus, dut, hitl, loopback, stream, vfc};
 pub use margemu_sim::{
-    bench, csv_column, filter_params, guard, input_file, marg, meta, motion, output, quat,
+    bench, csv_column, filter_params, guard, input_file, marg, mcap, meta, motion, output, quat,
     reference, run, rundir, sampling, scene, truth,
 };
 
@@ -28,4 +28,5 @@ pub mod demo;
 pub mod own_files;
 pub mod perf;
 pub mod perf_chain;
+pub mod perf_mcap;
 pub mod vfc_score;

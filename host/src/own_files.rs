@@ -7,6 +7,7 @@ use margemu_sim::rundir::OwnFiles;
 /// The lists: a run's, a session's, the device under test's, an evaluation's and the demo's.
 pub const OWN_FILES: OwnFiles = &[
     &margemu_sim::output::RUN_FILES,
+    &margemu_sim::mcap::FILES,
     &margemu_hil::stream::log::SESSION_FILES,
     &margemu_hil::dut::log::FILES,
     &margemu_hil::hitl::session::HITL_FILES,

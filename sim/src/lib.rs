@@ -29,6 +29,7 @@ pub mod filter_params;
 pub mod guard;
 pub mod input_file;
 pub mod marg;
+pub mod mcap;
 pub mod meta;
 pub mod motion;
 pub mod output;

@@ -3,6 +3,7 @@
 
 use crate::bench::{pid::Design, FrictionEvent};
 use crate::marg::{MargSim, MargWriter};
+use crate::mcap::{self, MargReading, McapLog, McapSetup};
 use crate::meta::{PidMeta, RunMeta};
 use crate::motion::Motion;
 use crate::output::{TruthWriter, RUN_FILES, TRUTH_COLUMNS};
@@ -127,10 +128,29 @@ pub fn simulate_to_dir(
     stop: &AtomicBool,
     progress: impl FnMut(u64, u64),
 ) -> Result<RunSummary, RunError> {
+    simulate_to_dir_with(scene, dir, stop, progress, &RunOutputs::default())
+}
+
+/// What a run directory holds besides the CSV files, which are always written.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunOutputs {
+    /// Also write `run.mcap` ([`crate::mcap`]): the truth and device 0's MARG samples (plate
+    /// axes, frame `plate`), written, renamed and counted like the CSV files.
+    pub mcap: bool,
+}
+
+/// [`simulate_to_dir`], with the extra files `outputs` asks for.
+pub fn simulate_to_dir_with(
+    scene: &Scene,
+    dir: &Path,
+    stop: &AtomicBool,
+    progress: impl FnMut(u64, u64),
+    outputs: &RunOutputs,
+) -> Result<RunSummary, RunError> {
     std::fs::create_dir_all(dir).map_err(write_err(dir))?;
     crate::meta::write(dir, &metadata(scene)).map_err(write_err(&dir.join(rundir::META_FILE)))?;
     let mut written = 0;
-    let outcome = write_files(scene, dir, stop, &mut written, progress);
+    let outcome = write_files(scene, dir, stop, &mut written, progress, outputs);
     let (status, ended) = match &outcome {
         Ok(_) => (Status::Complete, "completed".to_string()),
         Err(RunError::Interrupted) => (Status::Interrupted, RunError::Interrupted.to_string()),
@@ -162,6 +182,7 @@ fn write_files(
     stop: &AtomicBool,
     written: &mut u64,
     progress: impl FnMut(u64, u64),
+    outputs: &RunOutputs,
 ) -> Result<RunSummary, RunError> {
     let mut marg = MargSim::new(scene).map_err(RunError::Model)?;
     let [truth_name, marg_name, pert_name] = RUN_FILES;
@@ -182,6 +203,14 @@ fn write_files(
     };
     let mut marg_out =
         MargWriter::new(create(marg_name)?, pert_out).map_err(write_err(&marg_path))?;
+    let mcap_path = rundir::partial_path(dir, mcap::RUN_MCAP);
+    let mut mcap_out = match outputs.mcap {
+        true => {
+            names.push(mcap::RUN_MCAP);
+            Some(McapLog::create(&mcap_path, &mcap_setup(scene)).map_err(write_err(&mcap_path))?)
+        }
+        false => None,
+    };
     let sink = |t: &Truth| -> Result<(), RunError> {
         if stop.load(Ordering::Relaxed) {
             return Err(RunError::Interrupted);
@@ -193,6 +222,11 @@ fn write_files(
         truth_out.write(t).map_err(|e| failed(&truth_path, e))?;
         let sample = marg.try_sample(scene, t).map_err(RunError::NonFinite)?;
         marg_out.write(&sample).map_err(|e| failed(&marg_path, e))?;
+        if let Some(out) = &mut mcap_out {
+            out.truth(t)
+                .and_then(|_| out.marg(0, &reading(scene, &sample)))
+                .map_err(|e| failed(&mcap_path, e))?;
+        }
         *written += 1;
         Ok(())
     };
@@ -200,13 +234,41 @@ fn write_files(
     let flushed = truth_out
         .finish()
         .map_err(write_err(&truth_path))
-        .and_then(|_| marg_out.finish().map_err(write_err(&marg_path)));
+        .and_then(|_| marg_out.finish().map_err(write_err(&marg_path)))
+        .and_then(|_| match mcap_out {
+            Some(out) => out.finish().map(drop).map_err(write_err(&mcap_path)),
+            None => Ok(()),
+        });
     for name in names {
         rundir::commit_partial(dir, name).map_err(write_err(&dir.join(name)))?;
     }
     let summary = outcome?;
     flushed?;
     Ok(summary)
+}
+
+/// `run.mcap`'s channels and metadata: the truth and device 0 in plate axes.
+fn mcap_setup(scene: &Scene) -> McapSetup {
+    McapSetup {
+        scene: scene.stem().to_string(),
+        seed: scene.spec.seed,
+        field_unit: scene.spec.field.unit,
+        ut_per_unit: mcap::ut_per_unit(scene.spec.field.unit),
+        devices: vec![(scene.chip_name.clone(), mcap::PLATE_FRAME.to_string())],
+        clock: "scene time (ns since the scene start)".to_string(),
+    }
+}
+
+/// A MARG sample of `scene` as `run.mcap` writes it: marg.csv's values, the field in µT.
+pub fn reading(scene: &Scene, sample: &crate::marg::MargSample) -> MargReading {
+    let s = &sample.sample;
+    let ut = mcap::ut_per_unit(scene.spec.field.unit);
+    MargReading {
+        t_ns: sample.t_ns,
+        acc: s.acc.map(f64::from),
+        gyr: s.gyr.map(f64::from),
+        mag_ut: Some(s.mag.map(|v| f64::from(v) * ut)),
+    }
 }
 
 /// The run's `meta.toml`: scene, its SHA-256, seed, settings, PID gains and the scene text.

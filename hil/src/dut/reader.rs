@@ -5,6 +5,7 @@ use super::log::DutLog;
 use super::mavlink_in::MavlinkDecoder;
 use super::msp::{self, MspDecoder, MspVersion};
 use super::{DutEnd, DutError, DutProtocol, DutSummary};
+use crate::stream::LogSink;
 use std::collections::BTreeMap;
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
@@ -25,6 +26,9 @@ pub struct DutConfig {
     pub msp_requests: MspVersion,
     /// The CSV files are flushed at least this often (and when the reader ends).
     pub flush_period: Duration,
+    /// Where each attitude also goes: the session's `session.mcap`
+    /// ([`Session::log_sink`](crate::stream::Session::log_sink)).
+    pub session_log: Option<LogSink>,
 }
 
 impl DutConfig {
@@ -35,6 +39,7 @@ impl DutConfig {
             msp_poll_hz: 50.0,
             msp_requests: MspVersion::V1,
             flush_period: Duration::from_millis(100),
+            session_log: None,
         }
     }
 }
@@ -248,7 +253,12 @@ impl Worker {
                 .entry(d.message.name.clone().into_owned())
                 .or_default() += 1;
             match d.sample {
-                Some(super::Sample::Attitude(_)) => self.rows[0] += 1,
+                Some(super::Sample::Attitude(a)) => {
+                    self.rows[0] += 1;
+                    if let Some(sink) = &self.config.session_log {
+                        sink.dut_attitude(host_ns, a.attitude.quaternion);
+                    }
+                }
                 Some(super::Sample::Imu(_)) => self.rows[1] += 1,
                 None => {}
             }

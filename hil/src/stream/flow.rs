@@ -253,6 +253,12 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
             host_ns(start),
             self.pacing.next()
         );
+        let start_ns = host_ns(start);
+        let log = self.session.logger_mut();
+        log.queue(move |log| {
+            log.started(start_ns);
+            Ok(())
+        })?;
         self.event("start", &detail)?;
         while self.pacing.has_next(&self.plan) {
             self.send_next()?;

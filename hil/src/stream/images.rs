@@ -34,12 +34,12 @@ use margemu_protocol::chip::{ChipSettings, PhysicalSample};
 use margemu_protocol::link::Image;
 use margemu_sim::marg::MargSim;
 use margemu_sim::scene::chip::ChipSetup;
-use margemu_sim::scene::{FieldUnit, Scene};
+use margemu_sim::scene::Scene;
 use margemu_sim::truth::Truth;
 
 /// µT per normalized field unit ("nu") unless told otherwise: the author's reference field has
 /// about unit norm, and 50 µT is a typical geomagnetic magnitude.
-pub const DEFAULT_UT_PER_NU: f64 = 50.0;
+pub const DEFAULT_UT_PER_NU: f64 = margemu_sim::mcap::UT_PER_NU;
 
 /// How physical samples become register images. Every field is written to `meta.toml`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -60,10 +60,7 @@ impl ImageSettings {
     pub fn for_scene(scene: &Scene) -> Self {
         Self {
             chip: scene.chip.settings,
-            mag_ut_per_unit: match scene.spec.field.unit {
-                FieldUnit::Microtesla => 1.0,
-                FieldUnit::Normalized => DEFAULT_UT_PER_NU,
-            },
+            mag_ut_per_unit: margemu_sim::mcap::ut_per_unit(scene.spec.field.unit),
             default_temp_c: 25.0,
         }
     }

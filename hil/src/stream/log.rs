@@ -19,12 +19,16 @@
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before,device`: each write of the device under test (`bus` spi, i2c or aux; `address`: the I2C address, or on SPI the chip select of the device written, 0 for device 0; `dropped_before`: writes the device lost just before this batch; `device`: the name of the scene's device it reached, empty if none answers that address) |
 //! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `resend_out_of_window` (a hole older than the items the session keeps: not resent), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
 //!
+//! With [`StreamConfig::mcap`](super::StreamConfig::mcap), `session.mcap` is written beside
+//! them, by the same writer, from the same rows (`super::mcap_log`).
+//!
 //! `meta.toml` ends with the `[completion]` table (status, samples written, why the session
 //! ended; [`margemu_sim::rundir`]), written once every file is closed: after the session, or after
 //! the device under test's reader when one is attached.
 
 use super::clipping::{ClippingWriter, Clips};
 use super::device_truth::DeviceTruthWriter;
+use super::mcap_log::SessionMcap;
 use margemu_model::sensor;
 use margemu_protocol::link::{Bus, Image, RegisterWrite, ServedSample, Telemetry};
 use margemu_sim::meta::{Appended, SessionMeta};
@@ -147,6 +151,8 @@ pub struct SessionLog {
     device_truth: Option<DeviceTruthWriter>,
     /// `clipping.csv`.
     clipping: ClippingWriter,
+    /// `session.mcap`, when asked for.
+    mcap: Option<SessionMcap>,
 }
 
 fn create(dir: &Path, name: &str, header: &str) -> io::Result<BufWriter<File>> {
@@ -193,9 +199,31 @@ impl SessionLog {
                 dir,
                 &devices.iter().map(|d| d.name.clone()).collect::<Vec<_>>(),
             )?,
+            mcap: None,
         };
         log.flush()?;
         Ok(log)
+    }
+
+    /// Also writes `session.mcap` from now on.
+    pub(super) fn with_mcap(mut self, mcap: SessionMcap) -> Self {
+        self.mcap = Some(mcap);
+        self
+    }
+
+    /// Start was sent at `host_ns` (`session.mcap`'s events are at scene time from now on).
+    pub(super) fn started(&mut self, host_ns: i64) {
+        if let Some(m) = &mut self.mcap {
+            m.started(host_ns);
+        }
+    }
+
+    /// The device under test's attitude, received at `host_ns` (`session.mcap` only).
+    pub(super) fn dut_attitude(&mut self, host_ns: i64, q: [f64; 4]) -> io::Result<()> {
+        match &mut self.mcap {
+            Some(m) => m.dut_attitude(host_ns, q),
+            None => Ok(()),
+        }
     }
 
     /// The session directory.
@@ -211,6 +239,9 @@ impl SessionLog {
     /// Rows of `truth.csv` (and a rig's `device_truth.csv`), in order.
     pub fn truth(&mut self, truths: &[Truth]) -> io::Result<()> {
         truths.iter().try_for_each(|t| self.truth.write(t))?;
+        if let Some(m) = &mut self.mcap {
+            m.truth(truths)?;
+        }
         match &mut self.device_truth {
             Some(d) => d.write(truths),
             None => Ok(()),
@@ -246,6 +277,9 @@ impl SessionLog {
         }
         if self.image_split.is_empty() {
             write!(self.sent, ",{image:x}")?;
+        }
+        if let (Some(m), false) = (&mut self.mcap, resend) {
+            m.image(t_ns, image)?;
         }
         writeln!(self.sent, ",{}", u8::from(resend))
     }
@@ -374,6 +408,9 @@ impl SessionLog {
 
     /// One row of `events.csv` (commas in `detail` become semicolons).
     pub fn event(&mut self, host_ns: i64, event: &str, detail: &str) -> io::Result<()> {
+        if let Some(m) = &mut self.mcap {
+            m.event(host_ns, event, detail)?;
+        }
         writeln!(
             self.events,
             "{host_ns},{event},{}",
@@ -381,9 +418,13 @@ impl SessionLog {
         )
     }
 
-    /// Writes what closes a file (the clipping totals) and flushes every file.
+    /// Writes what closes a file (the clipping totals, `session.mcap`'s summary) and flushes
+    /// every file.
     pub fn close(&mut self) -> io::Result<()> {
         self.clipping.finish()?;
+        if let Some(m) = self.mcap.take() {
+            m.finish()?;
+        }
         self.flush()
     }
 
@@ -398,6 +439,9 @@ impl SessionLog {
         self.truth.flush()?;
         if let Some(d) = &mut self.device_truth {
             d.flush()?;
+        }
+        if let Some(m) = &mut self.mcap {
+            m.flush()?;
         }
         self.events.flush()
     }

@@ -16,6 +16,7 @@ use margemu_sim::rundir::{Completion, CompletionRecord};
 use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{channel, Sender};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 
 /// One queued write.
@@ -27,6 +28,36 @@ pub(super) struct Logger {
     tx: Option<Sender<Job>>,
     thread: Option<JoinHandle<io::Result<()>>>,
     completion: Option<CompletionRecord>,
+    /// The senders other threads were given ([`Logger::sink`]): emptied when the writer ends.
+    shared: Option<Arc<Mutex<Option<Sender<Job>>>>>,
+}
+
+/// A handle another thread (the device under test's reader) queues writes of the session's
+/// logs on: they run on the log writer thread, in order with the session's own. Once the
+/// session's logs are closed, what it is given is dropped (those rows are in the reader's own
+/// CSV files); a write that fails fails the session's logs, as the session's own do.
+#[derive(Clone)]
+pub struct LogSink {
+    tx: Arc<Mutex<Option<Sender<Job>>>>,
+}
+
+impl std::fmt::Debug for LogSink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LogSink")
+    }
+}
+
+impl LogSink {
+    /// The device under test's attitude `q` (`(w, x, y, z)`, body to world), received at host
+    /// time `host_ns`: `session.mcap`'s `/dut/attitude` and `/tf` world→dut.
+    pub fn dut_attitude(&self, host_ns: i64, q: [f64; 4]) {
+        let tx = self.tx.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(tx) = tx.as_ref() {
+            let _ = tx.send(Box::new(move |log: &mut SessionLog| {
+                log.dut_attitude(host_ns, q)
+            }));
+        }
+    }
 }
 
 impl Logger {
@@ -52,6 +83,7 @@ impl Logger {
             tx: Some(tx),
             thread: Some(thread),
             completion,
+            shared: None,
         })
     }
 
@@ -73,6 +105,16 @@ impl Logger {
         };
         record.update(|c| *c = completion);
         finished.and(record.release())
+    }
+
+    /// A handle for another thread to queue writes on ([`LogSink`]).
+    pub(super) fn sink(&mut self) -> LogSink {
+        let tx = self.tx.clone();
+        let shared = self
+            .shared
+            .get_or_insert_with(|| Arc::new(Mutex::new(tx)))
+            .clone();
+        LogSink { tx: shared }
     }
 
     /// The session directory.
@@ -112,6 +154,9 @@ impl Logger {
 
     /// Writes what is queued, flushes, and ends the writer; returns its first error.
     pub(super) fn finish(&mut self) -> io::Result<()> {
+        if let Some(shared) = &self.shared {
+            shared.lock().unwrap_or_else(|e| e.into_inner()).take();
+        }
         drop(self.tx.take());
         match self.thread.take().map(JoinHandle::join) {
             None => Ok(()),

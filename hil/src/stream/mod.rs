@@ -85,6 +85,7 @@ pub mod images;
 mod lateness;
 pub mod log;
 mod logger;
+mod mcap_log;
 pub(crate) mod meta;
 pub mod model;
 mod pacing;
@@ -102,6 +103,7 @@ pub mod window;
 
 pub use images::{predict_images, ImageSettings, PredictedSample};
 pub use lateness::Lateness;
+pub use logger::LogSink;
 pub use model::{
     device_chip, kinematics_hold, model_images, predict_model, ModelPrediction, ModelSample,
 };

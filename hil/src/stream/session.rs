@@ -8,6 +8,7 @@ use super::flow::Run;
 use super::images::{predict_images, ImageSettings};
 use super::log::{SentLayout, SessionLog};
 use super::logger::Logger;
+use super::mcap_log::SessionMcap;
 use super::meta::metadata;
 use super::model::predict_model;
 use super::plan::Plan;
@@ -72,6 +73,9 @@ pub struct StreamConfig {
     /// after it) may be written again: the line's delivery time (a loaded machine's PTY can
     /// take over 10 ms). Over a UART, add the line time of a batch (`margemu stream` does).
     pub resend_after: Duration,
+    /// Also write `session.mcap` (ROS 2 messages for Foxglove and `ros2 bag`), on the log
+    /// writer thread with the CSV files.
+    pub mcap: bool,
 }
 
 impl Default for StreamConfig {
@@ -90,6 +94,7 @@ impl Default for StreamConfig {
             spin: Duration::from_micros(200),
             session_id: 0x6D61_7267, // "marg"
             resend_after: Duration::from_millis(20),
+            mcap: false,
         }
     }
 }
@@ -150,7 +155,13 @@ impl Session {
             Items::Kinematics { .. } => SentLayout::Kinematics,
         };
         let devices = scene.devices();
-        let log = SessionLog::create(dir, &meta, &sent, &devices).map_err(log_err)?;
+        let mut log = SessionLog::create(dir, &meta, &sent, &devices).map_err(log_err)?;
+        if config.mcap {
+            let images = matches!(items, Items::Images);
+            let mcap =
+                SessionMcap::create(dir, scene, images, settings.chip, settings.mag_ut_per_unit);
+            log = log.with_mcap(mcap.map_err(log_err)?);
+        }
         let log = Logger::spawn(log).map_err(log_err)?;
         let others = scene.other_devices.iter().map(|d| d.chip).collect();
         let chips = (scene.chip, others);
@@ -176,6 +187,12 @@ impl Session {
     /// [`crate::dut`]) can share the session's clock.
     pub fn set_origin(&mut self, origin: Instant) {
         self.origin = Some(origin);
+    }
+
+    /// A handle the device under test's reader writes its attitude into `session.mcap` with;
+    /// `None` unless the session writes one ([`StreamConfig::mcap`]).
+    pub fn log_sink(&mut self) -> Option<super::LogSink> {
+        self.config.mcap.then(|| self.log.sink())
     }
 
     /// A share of the session directory's completion record ([`margemu_sim::rundir`]), for a writer

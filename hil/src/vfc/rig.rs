@@ -158,6 +158,10 @@ pub fn attach(
 ) -> Result<AttachedDut, DutError> {
     let origin = Instant::now();
     session.set_origin(origin);
+    let config = DutConfig {
+        session_log: session.log_sink(),
+        ..config
+    };
     AttachedDut::start(port, config, dir, origin, session.completion_record())
 }
 

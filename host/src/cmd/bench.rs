@@ -38,6 +38,13 @@ pub enum Cmd {
         #[arg(long, default_value_t = 0.5)]
         seconds: f64,
     },
+    /// What writing `run.mcap` costs per sample against the CSV files (truth + MARG, written
+    /// to memory), in time and bytes.
+    Mcap {
+        /// Least wall time spent timing each format (s).
+        #[arg(long, default_value_t = 1.0)]
+        seconds: f64,
+    },
     /// Real-time streaming through a PTY pair to the firmware's link handler: samples served
     /// byte for byte and lost at each rate, pacing jitter, link efficiency and the rates a UART
     /// carries.
@@ -124,6 +131,32 @@ impl Cmd {
                         r.chip, r.rate_hz, r.case, r.ns_per_sample
                     );
                 }
+            }
+            Cmd::Mcap { seconds } => {
+                let scene = inline(KINEMATIC, "kinematic sines")?;
+                println!(
+                    "{} samples of a kinematic scene at {} Hz: truth + MARG written to memory as \
+                     simulate writes them\n",
+                    scene.samples(),
+                    scene.clock.hz()
+                );
+                println!("| files | ns per sample | bytes per sample |");
+                println!("|---|---|---|");
+                let rows =
+                    margemu::perf_mcap::output_costs(&scene, Duration::from_secs_f64(seconds))
+                        .map_err(anyhow::Error::msg)?;
+                for r in &rows {
+                    println!(
+                        "| {} | {:.0} | {:.0} |",
+                        r.format, r.ns_per_sample, r.bytes_per_sample
+                    );
+                }
+                let [csv, mcap] = &rows;
+                println!(
+                    "\nMCAP / CSV: {:.2}× the time, {:.2}× the bytes",
+                    mcap.ns_per_sample / csv.ns_per_sample,
+                    mcap.bytes_per_sample / csv.bytes_per_sample
+                );
             }
             Cmd::Modes { seconds } => {
                 let scenes = [

@@ -30,6 +30,9 @@ pub struct Cmd {
     size: super::SizeArgs,
     #[command(flatten)]
     vfc: VfcArgs,
+    /// Also write `session.mcap` (ROS 2 messages for Foxglove and `ros2 bag`; docs/mcap.md).
+    #[arg(long)]
+    mcap: bool,
 }
 
 impl Cmd {
@@ -51,6 +54,7 @@ impl Cmd {
             port: label.clone(),
             images: Some(settings),
             source: self.source.mode()?,
+            mcap: self.mcap,
             ..StreamConfig::default()
         };
         let mut session = prepare(&scene, config, &dir)?;

@@ -1,4 +1,4 @@
-//! `margemu simulate SCENE [-o DIR] [--force]`: run a scene and write its run directory
+//! `margemu simulate SCENE [-o DIR] [--force] [--mcap]`: run a scene and write its run directory
 //! (default `runs/<scene name>`, numbered if taken: [`margemu::rundir`]).
 
 use anyhow::{Context, Result};
@@ -17,6 +17,9 @@ pub struct Cmd {
     output: OutputArgs,
     #[command(flatten)]
     size: super::SizeArgs,
+    /// Also write `run.mcap` (ROS 2 messages for Foxglove and `ros2 bag`; docs/mcap.md).
+    #[arg(long)]
+    mcap: bool,
 }
 
 impl Cmd {
@@ -41,7 +44,8 @@ impl Cmd {
             }
             bar.set_position(done);
         };
-        let summary = margemu::run::simulate_to_dir(&scene, &dir, &stop, progress)
+        let outputs = margemu::run::RunOutputs { mcap: self.mcap };
+        let summary = margemu::run::simulate_to_dir_with(&scene, &dir, &stop, progress, &outputs)
             .with_context(|| format!("simulating {}", scene.path.display()))?;
         bar.finish_and_clear();
         println!(

@@ -42,6 +42,9 @@ pub struct Cmd {
     dut: DutArgs,
     #[command(flatten)]
     size: super::SizeArgs,
+    /// Also write `session.mcap` (ROS 2 messages for Foxglove and `ros2 bag`; docs/mcap.md).
+    #[arg(long)]
+    mcap: bool,
 }
 
 /// Which chip the device emulates.
@@ -159,6 +162,7 @@ impl Cmd {
             lead: Duration::from_secs_f64(self.lead_ms / 1000.0),
             batch,
             resend_after: resend_after(batch, self.baud),
+            mcap: self.mcap,
             ..StreamConfig::default()
         };
         let port =
