@@ -7,6 +7,10 @@
 //! A session's device output and an external recording are read into memory (a session also
 //! keeps its truth's field, for the measured magnetic phase).
 //!
+//! An external recording's rows without a reference quaternion are left out of the truth and
+//! counted; with a [`Mask`], the rows it keeps are counted, and an estimate is scored only when
+//! the recording row nearest its aligned instant has a reference and is kept.
+//!
 //! Time stamps of `dut_attitude.csv` rows, on the scene's axis (ns since scene time 0):
 //! - `host_ns − start_host_ns` (arrival time) by default;
 //! - when every kept row has a `device_time_us` and those increase: the clock fit's host time
@@ -18,10 +22,10 @@
 
 use super::align::{fit_clock, TruthFacts};
 use super::device_log::{read_meta, read_sent};
-use super::input::{read_dut_attitude, read_external, DutRow, Imu, VectorRows};
+use super::input::{read_dut_attitude, read_external_masked, DutRow, Imu, VectorRows};
 use super::phase::{classify, classify_marks, Marks, Phase, PhaseRules, PhaseSample};
 use super::quat::{from_euler, geodesic, normalize};
-use super::run::{Clock, EvalError, EvalOptions, LatencyMode, Norms, Source};
+use super::run::{Clock, EvalError, EvalOptions, LatencyMode, Mask, Norms, Source};
 use super::score::{ScoreError, Stamped};
 use super::series::{Extent, Series};
 use super::signals::{external_phases, measured_field_deviation, norms};
@@ -42,6 +46,29 @@ pub(super) struct Loaded {
     pub(super) norms: Norms,
     pub(super) clock: Clock,
     pub(super) default_latency: LatencyMode,
+    /// An external recording's rows and which of them are scored.
+    pub(super) rows: Option<ScoredRows>,
+}
+
+/// The instants of a recording's rows and whether each is scored (it has a reference and the
+/// mask keeps it).
+pub(super) struct ScoredRows {
+    t_ns: Vec<u64>,
+    scored: Vec<bool>,
+}
+
+impl ScoredRows {
+    /// Whether the row nearest `t_ns` (the earlier of two equally near) is scored.
+    pub(super) fn scores(&self, t_ns: i64) -> bool {
+        let t = t_ns.max(0) as u64;
+        let after = self.t_ns.partition_point(|&r| r < t);
+        let nearest = match (after.checked_sub(1), self.t_ns.get(after)) {
+            (Some(b), Some(&a)) if a - t < t - self.t_ns[b] => after,
+            (Some(b), _) => b,
+            (None, _) => after,
+        };
+        self.scored.get(nearest).copied().unwrap_or(false)
+    }
 }
 
 /// Reads `source`.
@@ -53,9 +80,7 @@ pub(super) fn load(source: &Source, options: &EvalOptions) -> Result<Loaded, Eva
     let mut loaded = match source {
         Source::Session(dir) => load_session(dir, options),
         Source::Estimates { dir, estimates } => load_run(dir, estimates, &options.rules),
-        Source::External { file, estimates } => {
-            load_external(file, estimates.as_deref(), &options.rules)
-        }
+        Source::External { file, estimates } => load_external(file, estimates.as_deref(), options),
     }?;
     loaded.notes.extend(incomplete);
     Ok(loaded)
@@ -243,6 +268,7 @@ fn load_run(dir: &Path, estimates: &Path, rules: &PhaseRules) -> Result<Loaded, 
         norms: scan.norms,
         clock: Clock::Absent,
         default_latency: LatencyMode::Fixed(0),
+        rows: None,
     })
 }
 
@@ -277,10 +303,23 @@ fn in_memory(
 fn load_external(
     file: &Path,
     estimates: Option<&Path>,
-    rules: &PhaseRules,
+    options: &EvalOptions,
 ) -> Result<Loaded, EvalError> {
-    let rec = read_external(file)?;
-    let mut inputs = vec![format!("{} ({} rows)", file.display(), rec.reference.len())];
+    let rules = &options.rules;
+    let column = match &options.mask {
+        Mask::Column(c) => Some(c.as_str()),
+        _ => None,
+    };
+    let rec = read_external_masked(file, column)?;
+    let rows = rec.imu.t_ns.len();
+    let mut inputs = vec![format!("{} ({rows} rows)", file.display())];
+    let mut notes = Vec::new();
+    if rec.missing_reference > 0 {
+        notes.push(format!(
+            "{} of {rows} rows have no reference quaternion (empty or NaN): skipped",
+            rec.missing_reference
+        ));
+    }
     let est = match (estimates, rec.estimate) {
         (Some(path), _) => {
             let e = super::input::read_estimates(path)?;
@@ -295,13 +334,47 @@ fn load_external(
             })
         }
     };
+    if rec.reference.is_empty() {
+        return Err(EvalError::Input {
+            path: file.to_path_buf(),
+            reason: format!("no row has a reference quaternion ({rows} rows)"),
+        });
+    }
     let (truth, truth_extent, facts, estimates, estimate_extent) =
         in_memory(&inputs, &rec.reference, &est)?;
     let imu = &rec.imu;
-    let phases = classify(&external_phases(imu, rules), rules, facts.median_step_ns);
+    let samples = external_phases(imu, rules);
+    let all_phases = classify(&samples, rules, facts.median_step_ns);
+    let phases = rec.reference_rows.iter().map(|&r| all_phases[r]).collect();
+    let (kept, rule): (Vec<bool>, String) = match &options.mask {
+        Mask::All => (vec![true; rows], String::new()),
+        Mask::Column(c) => (
+            rec.mask.clone().unwrap_or_default(),
+            format!("column `{c}` nonzero"),
+        ),
+        Mask::Rest(r) => (
+            samples.iter().map(|s| s.rate < *r).collect(),
+            format!("rest: averaged gyro norm below {r} rad/s"),
+        ),
+        Mask::Motion(r) => (
+            samples.iter().map(|s| s.rate >= *r).collect(),
+            format!("motion: averaged gyro norm at or above {r} rad/s"),
+        ),
+    };
+    let mut scored = vec![false; rows];
+    for &r in &rec.reference_rows {
+        scored[r] = kept[r];
+    }
+    if options.mask != Mask::All {
+        notes.push(format!(
+            "mask ({rule}): {} of {rows} rows kept, {} of them with a reference",
+            kept.iter().filter(|&&k| k).count(),
+            scored.iter().filter(|&&k| k).count()
+        ));
+    }
     Ok(Loaded {
         inputs,
-        notes: Vec::new(),
+        notes,
         truth,
         truth_extent,
         facts,
@@ -311,6 +384,10 @@ fn load_external(
         norms: norms("the recording's IMU columns", &imu.t_ns, &imu.acc, &imu.mag),
         clock: Clock::Absent,
         default_latency: LatencyMode::Fixed(0),
+        rows: Some(ScoredRows {
+            t_ns: rec.imu.t_ns,
+            scored,
+        }),
     })
 }
 
@@ -430,6 +507,7 @@ fn load_session(dir: &Path, options: &EvalOptions) -> Result<Loaded, EvalError> 
         norms: scan.norms,
         clock,
         default_latency: LatencyMode::Auto,
+        rows: None,
     })
 }
 

@@ -22,9 +22,11 @@ pub struct Cmd {
     /// accel_noise, mag_noise). Repeatable.
     #[arg(long = "param", value_name = "NAME=VALUE")]
     param: Vec<String>,
-    /// World magnetic reference x,y,z (default: the run's scene, or (0.5, 0, -0.83) for a CSV).
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
-    mag_reference: Option<Vec<f64>>,
+    /// World magnetic reference `X,Y,Z` (spaces after commas allowed), or `auto`: estimated
+    /// from the CSV recording's first rest phase (the default for a CSV; a run directory's
+    /// default is its scene's).
+    #[arg(long, allow_hyphen_values = true, value_name = "X,Y,Z|auto")]
+    mag_reference: Option<String>,
     /// Where the filter starts: first-sample (TRIAD on the first sample) or truth (the true
     /// attitude at the first sample, from a run directory's truth.csv).
     #[arg(long, default_value = "first-sample")]
@@ -32,6 +34,22 @@ pub struct Cmd {
     /// The estimates file: t_s,qw,qx,qy,qz,roll,pitch,yaw.
     #[arg(short, long)]
     output: PathBuf,
+}
+
+/// The magnetic reference estimated from the recording at `input`, printed with its rows; when
+/// the estimate fails and it was not asked for (`explicit`), the default, with a note.
+fn estimated(input: &std::path::Path, explicit: bool) -> Result<Option<[f64; 3]>> {
+    match offline::mag_estimate::estimate(input) {
+        Ok(e) => {
+            println!("{e}");
+            Ok(Some(e.reference))
+        }
+        Err(e) if explicit => Err(anyhow::anyhow!("--mag-reference auto: {e}")),
+        Err(e) => {
+            println!("note: {e}; using the default reference instead");
+            Ok(None)
+        }
+    }
 }
 
 impl Cmd {
@@ -49,9 +67,13 @@ impl Cmd {
                 .with_context(|| format!("--param {assignment}"))?;
         }
         let reference = match self.mag_reference.as_deref() {
+            Some("auto") if self.input.is_dir() => {
+                bail!("--mag-reference auto: estimation applies to a CSV recording; a run directory's reference is its scene's")
+            }
+            Some("auto") => estimated(&self.input, true)?,
+            Some(text) => Some(super::parse_vector3("--mag-reference", text)?),
+            None if self.input.is_file() => estimated(&self.input, false)?,
             None => None,
-            Some(&[x, y, z]) => Some([x, y, z]),
-            Some(other) => bail!("--mag-reference needs three numbers, not {other:?}"),
         };
         let initial = match self.attitude_start {
             AttitudeStart::FirstSample => Initial::FirstSample,

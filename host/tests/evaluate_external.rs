@@ -1,0 +1,335 @@
+//! External recordings scored first-class: BROAD's heading and inclination split, reference
+//! rows missing (empty or NaN) skipped and counted, masks (a column, rest or motion), the
+//! magnetic reference estimated from a rest phase, and the command-line options and their
+//! errors.
+
+mod evaluate_common;
+
+use evaluate_common::{coords, euler_at, scratch};
+use margemu::evaluate::quat::from_euler;
+use margemu::evaluate::{evaluate, evaluate_writing, EvalOptions, Mask, Source};
+use margemu::offline::mag_estimate;
+use nalgebra::{UnitQuaternion, Vector3};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const HEADER: &str = "t_s,ax,ay,az,gx,gy,gz,mx,my,mz,qw,qx,qy,qz";
+
+/// A 100 Hz recording of `n` rows of the test motion; `row(k)` gives the extra cells after the
+/// reference (the reference itself replaced by `reference(k)` when it returns text).
+fn write_recording(
+    path: &Path,
+    extra_header: &str,
+    n: usize,
+    reference: impl Fn(usize) -> Option<String>,
+    extra: impl Fn(usize, &UnitQuaternion<f64>) -> String,
+) {
+    let mut text = format!("{HEADER}{extra_header}\n");
+    for k in 0..n {
+        let t = k as f64 * 0.01;
+        let q = from_euler(euler_at(t));
+        let r = reference(k).unwrap_or_else(|| {
+            let c = coords(&q);
+            format!("{},{},{},{}", c[0], c[1], c[2], c[3])
+        });
+        let _ = writeln!(
+            text,
+            "{t},0,0,9.80665,0,0,0,0.36,0,-0.93,{r}{}",
+            extra(k, &q)
+        );
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// `,qw_est,qx_est,qy_est,qz_est` cells of `error ⊗ q` (the error in the world frame).
+fn estimate_cells(error: &UnitQuaternion<f64>, q: &UnitQuaternion<f64>) -> String {
+    let c = coords(&(error * q));
+    format!(",{},{},{},{}", c[0], c[1], c[2], c[3])
+}
+
+const EST: &str = ",qw_est,qx_est,qy_est,qz_est";
+
+fn about(axis: Vector3<f64>, degrees: f64) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_scaled_axis(axis.normalize() * degrees.to_radians())
+}
+
+fn external(file: PathBuf) -> Source {
+    Source::External {
+        file,
+        estimates: None,
+    }
+}
+
+#[test]
+fn heading_only_and_inclination_only_errors_are_scored_exactly() {
+    let dir = scratch("ext-split");
+    let cases = [
+        ("heading", about(Vector3::z(), 3.0), [3.0, 0.0]),
+        (
+            "inclination",
+            about(Vector3::new(1.0, 2.0, 0.0), 2.0),
+            [0.0, 2.0],
+        ),
+    ];
+    for (name, error, expected) in cases {
+        let file = dir.join(format!("{name}.csv"));
+        write_recording(&file, EST, 500, |_| None, |_, q| estimate_cells(&error, q));
+        let errors = dir.join(format!("{name}-errors.csv"));
+        let eval =
+            evaluate_writing(&external(file), &EvalOptions::default(), Some(&errors)).unwrap();
+        let s = eval.scores;
+        assert_eq!(s.count, 500);
+        for (i, want) in expected.iter().enumerate() {
+            let [rms, max] = [s.heading_inclination_rms[i], s.heading_inclination_max[i]];
+            assert!((rms.to_degrees() - want).abs() < 1e-9, "{name} {i}: {s:?}");
+            assert!((max.to_degrees() - want).abs() < 1e-9, "{name} {i}: {s:?}");
+        }
+        // The geodesic is the whole of the one error there is.
+        let whole = expected[0] + expected[1];
+        assert!((s.geodesic_rms.to_degrees() - whole).abs() < 1e-9, "{s:?}");
+        let text = std::fs::read_to_string(&errors).unwrap();
+        let mut lines = text.lines();
+        assert!(lines
+            .next()
+            .unwrap()
+            .ends_with(",e_yaw,geodesic,heading,inclination"));
+        let cells: Vec<f64> = lines
+            .next()
+            .unwrap()
+            .rsplit(',')
+            .take(2)
+            .map(|c| c.parse().unwrap())
+            .collect();
+        assert!(
+            (cells[1].to_degrees() - expected[0]).abs() < 1e-9,
+            "{text:.300}"
+        );
+        assert!(
+            (cells[0].to_degrees() - expected[1]).abs() < 1e-9,
+            "{text:.300}"
+        );
+        assert!(
+            eval.latency_reason.contains("a search is optional"),
+            "{}",
+            eval.latency_reason
+        );
+    }
+}
+
+/// 100 rows: rows 10 to 19 have a NaN reference and row 30 an empty one; the mask column `keep`
+/// is 1 on rows below 60; the estimate is 1° off in heading where kept, 10° elsewhere.
+fn masked_recording(dir: &Path) -> PathBuf {
+    let file = dir.join("masked.csv");
+    let small = about(Vector3::z(), 1.0);
+    let large = about(Vector3::z(), 10.0);
+    write_recording(
+        &file,
+        &format!("{EST},keep"),
+        100,
+        |k| match k {
+            10..=19 => Some("NaN,NaN,NaN,NaN".into()),
+            30 => Some(",,,".into()),
+            _ => None,
+        },
+        |k, q| {
+            let e = if k < 60 { &small } else { &large };
+            format!("{},{}", estimate_cells(e, q), u8::from(k < 60))
+        },
+    );
+    file
+}
+
+#[test]
+fn missing_reference_rows_and_a_mask_column_leave_only_the_right_rows_scored() {
+    let dir = scratch("ext-mask");
+    let file = masked_recording(&dir);
+    // Without a mask: 89 rows with a reference, all scored.
+    let all = evaluate(&external(file.clone()), &EvalOptions::default()).unwrap();
+    assert_eq!(all.scores.count, 89);
+    assert!(
+        all.notes
+            .iter()
+            .any(|n| n.contains("11 of 100 rows have no reference quaternion")),
+        "{:?}",
+        all.notes
+    );
+    let options = EvalOptions {
+        mask: Mask::Column("keep".into()),
+        ..EvalOptions::default()
+    };
+    let eval = evaluate(&external(file), &options).unwrap();
+    // Rows 0..60 less the 11 without a reference.
+    assert_eq!(eval.scores.count, 49);
+    let h = eval.scores.heading_inclination_rms[0].to_degrees();
+    assert!((h - 1.0).abs() < 1e-9, "{:?}", eval.scores);
+    assert!(
+        eval.notes.iter().any(|n| n.contains(
+            "mask (column `keep` nonzero): 60 of 100 rows kept, 49 of them with a reference"
+        )),
+        "{:?}",
+        eval.notes
+    );
+}
+
+/// A 100 Hz recording at rest for 3 s in a tilted attitude, then turning, in a world field of
+/// 69° dip and 10° declination, measured with a little noise; `with_reference`: the reference
+/// attitude columns too.
+fn dip_recording(path: &Path, with_reference: bool) {
+    let dip = 69f64.to_radians();
+    let dec = 10f64.to_radians();
+    let world = Vector3::new(dip.cos() * dec.cos(), dip.cos() * dec.sin(), -dip.sin());
+    let mut text = String::from("t_s,ax,ay,az,gx,gy,gz,mx,my,mz");
+    text += if with_reference {
+        ",qw,qx,qy,qz\n"
+    } else {
+        "\n"
+    };
+    let tilt = from_euler([0.3, -0.2, 1.0]);
+    for k in 0..600 {
+        let t = k as f64 * 0.01;
+        let (q, w) = if t < 3.0 {
+            (tilt, 0.0)
+        } else {
+            (
+                tilt * about(Vector3::z(), 40.0 * (t - 3.0)),
+                40f64.to_radians(),
+            )
+        };
+        let f = q.inverse() * Vector3::new(0.0, 0.0, 9.80665);
+        let wobble = 0.01 * ((k * 7919) % 13) as f64 / 13.0 - 0.005;
+        let m = q.inverse() * world + Vector3::repeat(wobble);
+        let _ = write!(
+            text,
+            "{t},{},{},{},0,0,{w},{},{},{}",
+            f.x, f.y, f.z, m.x, m.y, m.z
+        );
+        if with_reference {
+            let c = coords(&q);
+            let _ = write!(text, ",{},{},{},{}", c[0], c[1], c[2], c[3]);
+        }
+        text.push('\n');
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn the_magnetic_reference_is_recovered_from_a_rest_phase() {
+    let dir = scratch("ext-dip");
+    for with_reference in [true, false] {
+        let file = dir.join(format!("dip-{with_reference}.csv"));
+        dip_recording(&file, with_reference);
+        let e = mag_estimate::estimate(&file).unwrap();
+        assert!((e.dip.to_degrees() - 69.0).abs() < 0.5, "{e}");
+        assert_eq!(e.from_attitude, with_reference);
+        assert_eq!(e.lines, (2, 301), "{e}");
+        let heading = e.reference[1].atan2(e.reference[0]).to_degrees();
+        let expected = if with_reference { 10.0 } else { 0.0 };
+        assert!((heading - expected).abs() < 0.5, "{e}");
+    }
+}
+
+fn margemu(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_margemu"))
+        .args(args)
+        .output()
+        .expect("runs margemu")
+}
+
+fn stdout(o: &Output) -> String {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    assert!(
+        !o.status.success(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn the_command_line_takes_the_new_options_and_names_them_in_its_errors() {
+    let dir = scratch("ext-cli");
+    let rec = dir.join("dip.csv");
+    dip_recording(&rec, false);
+    let (r, out) = (rec.to_str().unwrap(), dir.join("est.csv"));
+    let o = out.to_str().unwrap();
+    // The default for a CSV: estimated, printed with its rows.
+    let printed = stdout(&margemu(&["filter", "--filter", "ecf", r, "-o", o]));
+    assert!(
+        printed.contains("magnetic reference estimated:"),
+        "{printed}"
+    );
+    assert!(printed.contains("lines 2–301"), "{printed}");
+    for form in [
+        vec!["--mag-reference=-0.36,0,-0.93"],
+        vec!["--mag-reference", "-0.36,0,-0.93"],
+        vec!["--mag-reference", "-0.36, 0, -0.93"],
+        vec!["--mag-reference", "auto"],
+    ] {
+        let mut args = vec!["filter", "--filter", "ecf", r, "-o", o];
+        args.extend(form.iter().copied());
+        stdout(&margemu(&args));
+    }
+    for (extra, expected) in [
+        ("1,2", "--mag-reference needs three finite numbers X,Y,Z"),
+        ("1,x,2", "--mag-reference needs three finite numbers X,Y,Z"),
+        (
+            "1,inf,2",
+            "--mag-reference needs three finite numbers X,Y,Z",
+        ),
+    ] {
+        let e = stderr(&margemu(&[
+            "filter",
+            "--filter",
+            "ecf",
+            r,
+            "-o",
+            o,
+            "--mag-reference",
+            extra,
+        ]));
+        assert!(e.contains(expected), "{extra}: {e}");
+    }
+    // evaluate: masks.
+    let masked = masked_recording(&dir);
+    let m = masked.to_str().unwrap();
+    let eval_out = dir.join("evaluation");
+    let e_out = eval_out.to_str().unwrap();
+    let base = ["evaluate", "--no-plots", "--out", e_out, "--external", m];
+    let printed = stdout(&margemu(&[&base[..], &["--mask-column", "keep"]].concat()));
+    let n = printed
+        .lines()
+        .find_map(|l| l.strip_prefix("N "))
+        .and_then(|rest| rest.split_whitespace().next())
+        .unwrap_or_default();
+    assert_eq!(n, "49", "{printed}");
+    assert!(printed.contains("heading RMS (°)"), "{printed}");
+    assert!(!printed.contains("host arrival"), "{printed}");
+    let report = std::fs::read_to_string(eval_out.join("report.md")).unwrap();
+    assert!(report.contains("49 of them with a reference"), "{report}");
+    assert!(report.contains("inclination RMS (°)"), "{report}");
+    // Gyro zero throughout: every row at rest, none in motion.
+    let printed = stdout(&margemu(&[&base[..], &["--mask", "rest"]].concat()));
+    assert!(
+        printed.contains("100 of 100 rows kept, 89 of them"),
+        "{printed}"
+    );
+    let e = stderr(&margemu(&[&base[..], &["--mask", "motion"]].concat()));
+    assert!(e.contains("no truth instant to score"), "{e}");
+    for (extra, expected) in [
+        (vec!["--mask-column", "nope"], "no column `nope`"),
+        (vec!["--mask", "still"], "--mask"),
+        (
+            vec!["--mask", "rest", "--rest-rate", "-1"],
+            "--rest-rate must be",
+        ),
+        (vec!["--mask", "rest", "--mask-column", "keep"], "--mask"),
+    ] {
+        let e = stderr(&margemu(&[&base[..], &extra[..]].concat()));
+        assert!(e.contains(expected), "{extra:?}: {e}");
+    }
+}
