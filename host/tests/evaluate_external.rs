@@ -333,3 +333,49 @@ fn the_command_line_takes_the_new_options_and_names_them_in_its_errors() {
         assert!(e.contains(expected), "{extra:?}: {e}");
     }
 }
+
+#[test]
+fn a_filter_starts_from_a_recordings_reference_attitude() {
+    let dir = scratch("ext-start");
+    let rec = dir.join("dip.csv");
+    dip_recording(&rec, true);
+    let out = dir.join("est.csv");
+    let (r, o) = (rec.to_str().unwrap(), out.to_str().unwrap());
+    // A reference without the recording's 10° declination: a start from the first sample
+    // (TRIAD) is 10° off in heading; a start from the reference is not.
+    let first_estimate = |start: &str| {
+        let args = [
+            "filter",
+            "--filter",
+            "gda",
+            "--mag-reference",
+            "0.36,0,-0.93",
+            "--attitude-start",
+            start,
+            r,
+            "-o",
+            o,
+        ];
+        stdout(&margemu(&args));
+        let q = margemu::evaluate::input::read_estimates(&out).unwrap()[0].1;
+        UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]))
+    };
+    let tilt = from_euler([0.3, -0.2, 1.0]);
+    let truth = first_estimate("truth").angle_to(&tilt);
+    let triad = first_estimate("first-sample").angle_to(&tilt);
+    assert!(truth < 0.01 && triad > 0.1, "{truth} {triad}");
+    // Without reference columns, starting from the truth is refused, naming what is missing.
+    let plain = dir.join("plain.csv");
+    dip_recording(&plain, false);
+    let e = stderr(&margemu(&[
+        "filter",
+        "--filter",
+        "gda",
+        "--attitude-start",
+        "truth",
+        plain.to_str().unwrap(),
+        "-o",
+        o,
+    ]));
+    assert!(e.contains("needs the reference columns qw,qx,qy,qz"), "{e}");
+}

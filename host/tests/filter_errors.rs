@@ -130,7 +130,7 @@ fn the_command_line_refuses_bad_parameters_and_writes_nothing() {
         ),
         (
             &["--filter", "ecf", "--attitude-start", "truth"],
-            "needs a run directory with truth.csv",
+            "starting from the truth needs the reference columns qw,qx,qy,qz",
         ),
     ];
     for (extra, expected) in cases {

@@ -28,7 +28,8 @@ pub struct Cmd {
     #[arg(long, allow_hyphen_values = true, value_name = "X,Y,Z|auto")]
     mag_reference: Option<String>,
     /// Where the filter starts: first-sample (TRIAD on the first sample) or truth (the true
-    /// attitude at the first sample, from a run directory's truth.csv).
+    /// attitude at the first sample: a run directory's truth.csv, or a CSV recording's
+    /// reference columns qw,qx,qy,qz on its first row).
     #[arg(long, default_value = "first-sample")]
     attitude_start: AttitudeStart,
     /// The estimates file: t_s,qw,qx,qy,qz,roll,pitch,yaw.
