@@ -274,6 +274,37 @@ fn the_command_line_takes_the_new_options_and_names_them_in_its_errors() {
         args.extend(form.iter().copied());
         stdout(&margemu(&args));
     }
+    // Every filter option from the command line, the filter's name as an optional prefix.
+    let printed = stdout(&margemu(&[
+        "filter",
+        "--filter",
+        "gda",
+        r,
+        "-o",
+        o,
+        "--param",
+        "gda.normalization=xio",
+        "--param",
+        "beta=0.2",
+    ]));
+    assert!(
+        printed.contains("gda (beta=0.2, normalization=xio)"),
+        "{printed}"
+    );
+    let printed = stdout(&margemu(&[
+        "filter",
+        "--filter",
+        "ekf",
+        r,
+        "-o",
+        o,
+        "--param",
+        "ekf.initial_attitude_std=0.3",
+    ]));
+    assert!(
+        printed.contains("initial_attitude_std=0.3, initial_bias_std=0.05"),
+        "{printed}"
+    );
     for (extra, expected) in [
         ("1,2", "--mag-reference needs three finite numbers X,Y,Z"),
         ("1,x,2", "--mag-reference needs three finite numbers X,Y,Z"),

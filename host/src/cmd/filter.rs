@@ -18,8 +18,9 @@ pub struct Cmd {
     /// `[ekf]` table sets the filter's parameters.
     #[arg(long)]
     params: Option<PathBuf>,
-    /// NAME=VALUE, after --params (ecf: kp, ki; gda: beta; ekf: gyro_noise, gyro_bias_walk,
-    /// accel_noise, mag_noise). Repeatable.
+    /// NAME=VALUE, after --params (ecf: kp, ki; gda: beta, normalization=gradient|residual|xio;
+    /// ekf: gyro_noise, gyro_bias_walk, accel_noise, mag_noise, initial_attitude_std,
+    /// initial_bias_std); NAME may carry the filter as a prefix (gda.beta). Repeatable.
     #[arg(long = "param", value_name = "NAME=VALUE")]
     param: Vec<String>,
     /// World magnetic reference `X,Y,Z` (spaces after commas allowed), or `auto`: estimated
@@ -86,10 +87,7 @@ impl Cmd {
         for warning in run.warnings() {
             eprintln!("warning: {warning}");
         }
-        let values: Vec<String> = params
-            .iter()
-            .map(|(p, v)| format!("{}={v}", p.name))
-            .collect();
+        let values = params.assignments();
         println!(
             "{} ({}) over {} samples of {} in {:.3} s (reading and writing included); wrote {}",
             self.filter,
