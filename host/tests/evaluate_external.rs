@@ -410,3 +410,91 @@ fn a_filter_starts_from_a_recordings_reference_attitude() {
     ]));
     assert!(e.contains("needs the reference columns qw,qx,qy,qz"), "{e}");
 }
+
+/// A BROAD-like recording at 100 Hz: 3 s at rest, then turning at a constant body rate, in a
+/// field of 69° dip and 20° declination against the reference's x; the reference lost on rows
+/// 700 to 719; `movement` 1 after the rest.
+fn broad_like(path: &Path) {
+    let dip = 69f64.to_radians();
+    let dec = 20f64.to_radians();
+    let world = Vector3::new(dip.cos() * dec.cos(), dip.cos() * dec.sin(), -dip.sin()) * 50.0;
+    let start = from_euler([0.1, 0.2, 0.3]);
+    let rate = Vector3::new(0.3, -0.2, 0.8);
+    let mut text = format!("{HEADER},movement\n");
+    for k in 0..1500 {
+        let t = k as f64 * 0.01;
+        let moving = t >= 3.0;
+        let turned = if moving {
+            (t - 3.0) * rate
+        } else {
+            Vector3::zeros()
+        };
+        let q = start * UnitQuaternion::from_scaled_axis(turned);
+        let w = if moving { rate } else { Vector3::zeros() };
+        let f = q.inverse() * Vector3::new(0.0, 0.0, 9.80665);
+        let m = q.inverse() * world;
+        let c = coords(&q);
+        let reference = if (700..720).contains(&k) {
+            "nan,nan,nan,nan".to_string()
+        } else {
+            format!("{},{},{},{}", c[0], c[1], c[2], c[3])
+        };
+        let _ = writeln!(
+            text,
+            "{t},{},{},{},{},{},{},{},{},{},{reference},{}",
+            f.x,
+            f.y,
+            f.z,
+            w.x,
+            w.y,
+            w.z,
+            m.x,
+            m.y,
+            m.z,
+            u8::from(moving)
+        );
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn the_public_recording_recipe_runs_as_written() {
+    let dir = scratch("ext-recipe");
+    broad_like(&dir.join("broad.csv"));
+    let page = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/recipe-public-recording.md");
+    let text = std::fs::read_to_string(page).unwrap();
+    let mut in_sh = false;
+    let mut ran = 0;
+    for line in text.lines() {
+        if line.starts_with("```") {
+            in_sh = line == "```sh";
+            continue;
+        }
+        let Some(command) = line.strip_prefix("margemu ").filter(|_| in_sh) else {
+            continue;
+        };
+        let args: Vec<&str> = command.split_whitespace().collect();
+        let out = Command::new(env!("CARGO_BIN_EXE_margemu"))
+            .args(&args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let printed = stdout(&out);
+        if args[0] == "filter" {
+            assert!(printed.contains("dip 69.0"), "{line}: {printed}");
+        } else {
+            assert!(
+                printed.contains("20 of 1500 rows have no reference"),
+                "{line}: {printed}"
+            );
+            assert!(printed.contains("heading RMS (°)"), "{line}: {printed}");
+        }
+        ran += 1;
+    }
+    assert_eq!(ran, 4);
+    let report = std::fs::read_to_string(dir.join("gda-evaluation/report.md")).unwrap();
+    assert!(
+        report.contains("mask (column `movement` nonzero): 1200 of 1500 rows kept"),
+        "{report}"
+    );
+}

@@ -3,8 +3,8 @@
 //! with `--mag-reference auto`).
 //!
 //! The rest phase: the first run of consecutive rows whose gyro norm is below [`REST_RATE`] and
-//! that lasts at least [`MIN_REST_S`] (and [`MIN_REST_SAMPLES`] rows); the whole run is used. Over
-//! it:
+//! that lasts at least [`MIN_REST_S`] (and [`MIN_REST_SAMPLES`] rows); its first [`MAX_REST_S`]
+//! are used (so a recording at rest throughout is not read to its end). Over them:
 //! - with a reference attitude (`qw..qz`, body to world, filled on every row of the run): the
 //!   mean of the measured field rotated into the world, `q ⊗ m ⊗ q*`, so both the dip and the
 //!   horizontal direction are the recording's own;
@@ -26,6 +26,8 @@ pub const REST_RATE: f64 = 0.1;
 pub const MIN_REST_S: f64 = 1.0;
 /// Fewest rows in a rest phase used.
 pub const MIN_REST_SAMPLES: usize = 10;
+/// Longest stretch of a rest phase used (s).
+pub const MAX_REST_S: f64 = 10.0;
 
 /// An estimated world magnetic reference and where it came from.
 #[derive(Clone, Debug, PartialEq)]
@@ -118,6 +120,10 @@ pub fn estimate(path: &Path) -> Result<MagEstimate, InputError> {
             continue;
         }
         let (time, a, m) = (row.f64(t)?, row.f64s(acc)?, row.f64s(mag)?);
+        if run.rows > 0 && time - run.first_t > MAX_REST_S {
+            found = Some(std::mem::take(&mut run));
+            break;
+        }
         if run.rows == 0 {
             run.first_line = row.line();
             run.first_t = time;
