@@ -498,3 +498,120 @@ fn the_public_recording_recipe_runs_as_written() {
         "{report}"
     );
 }
+
+/// `text` (a recording in NWU, margemu's) rewritten in `frame`: body vectors and quaternions
+/// converted back out of margemu's axes.
+fn in_frame(text: &str, frame: margemu::frame::Frame) -> String {
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let names: Vec<&str> = header.split(',').collect();
+    let at = |n: &str| names.iter().position(|c| *c == n);
+    let mut out = format!("{header}\n");
+    for line in lines {
+        let mut v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        for group in [["ax", "ay", "az"], ["gx", "gy", "gz"], ["mx", "my", "mz"]] {
+            let i = group.map(|n| at(n).unwrap());
+            // The body conversion is its own inverse (identity or a half turn).
+            let b = frame.body_in([v[i[0]], v[i[1]], v[i[2]]]);
+            (v[i[0]], v[i[1]], v[i[2]]) = (b[0], b[1], b[2]);
+        }
+        if let Some(w) = at("qw") {
+            let q = frame.quat_out([v[w], v[w + 1], v[w + 2], v[w + 3]]);
+            v[w..w + 4].copy_from_slice(&q);
+        }
+        let cells: Vec<String> = v.iter().map(|x| x.to_string()).collect();
+        out += &cells.join(",");
+        out.push('\n');
+    }
+    out
+}
+
+#[test]
+fn a_recording_in_enu_or_ned_gives_the_nwu_results_in_its_own_frame() {
+    use margemu::frame::Frame;
+    let dir = scratch("ext-frame");
+    let nwu = dir.join("nwu.csv");
+    dip_recording(&nwu, true);
+    let text = std::fs::read_to_string(&nwu).unwrap();
+    let reference = [0.36, 0.0, -0.93];
+    let run = |file: &Path, frame: Frame, out: &Path| {
+        let r = frame_text(reference, frame);
+        stdout(&margemu(&[
+            "filter",
+            "--filter",
+            "ekf",
+            "--frame",
+            &frame.to_string(),
+            "--mag-reference",
+            &r,
+            file.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]));
+        margemu::evaluate::input::read_estimates(out).unwrap()
+    };
+    let base = run(&nwu, Frame::Nwu, &dir.join("nwu-est.csv"));
+    for frame in [Frame::Enu, Frame::Ned] {
+        let file = dir.join(format!("{frame}.csv"));
+        std::fs::write(&file, in_frame(&text, frame)).unwrap();
+        let est_path = dir.join(format!("{frame}-est.csv"));
+        let est = run(&file, frame, &est_path);
+        for (a, b) in base.iter().zip(&est) {
+            let back = frame.quat_in(b.1);
+            let dot: f64 = a.1.iter().zip(back).map(|(x, y)| x * y).sum();
+            assert!(
+                (dot.abs() - 1.0).abs() < 1e-9,
+                "{frame} at {}: {a:?} {back:?}",
+                a.0
+            );
+        }
+        // evaluate reads both in the frame: the same geodesic, heading and inclination.
+        let score = |file: &Path, est: &Path, frame: Frame| {
+            let options = EvalOptions {
+                frame,
+                ..EvalOptions::default()
+            };
+            let source = Source::External {
+                file: file.to_path_buf(),
+                estimates: Some(est.to_path_buf()),
+            };
+            evaluate(&source, &options).unwrap()
+        };
+        let a = score(&nwu, &dir.join("nwu-est.csv"), Frame::Nwu);
+        let b = score(&file, &est_path, frame);
+        assert!((a.scores.geodesic_rms - b.scores.geodesic_rms).abs() < 1e-9);
+        for i in 0..2 {
+            let (x, y) = (
+                a.scores.heading_inclination_rms[i],
+                b.scores.heading_inclination_rms[i],
+            );
+            assert!((x - y).abs() < 1e-9, "{frame} {i}: {x} {y}");
+        }
+        assert!(
+            b.notes
+                .iter()
+                .any(|n| n.starts_with(&format!("frame {frame}:"))),
+            "{:?}",
+            b.notes
+        );
+    }
+    let e = stderr(&margemu(&[
+        "filter", "--filter", "ekf", "--frame", "xyz", "a.csv", "-o", "b.csv",
+    ]));
+    assert!(e.contains("unknown frame `xyz` (nwu, enu or ned)"), "{e}");
+}
+
+/// `reference` (NWU) as `--mag-reference` text in `frame`.
+fn frame_text(reference: [f64; 3], frame: margemu::frame::Frame) -> String {
+    // world_in is a rotation: its inverse is its transpose, found by converting the axes.
+    let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(|e| frame.world_in(e));
+    let v: Vec<String> = (0..3)
+        .map(|j| {
+            (0..3)
+                .map(|i| axes[j][i] * reference[i])
+                .sum::<f64>()
+                .to_string()
+        })
+        .collect();
+    v.join(",")
+}

@@ -310,10 +310,25 @@ fn load_external(
         Mask::Column(c) => Some(c.as_str()),
         _ => None,
     };
-    let rec = read_external_masked(file, column)?;
+    let mut rec = read_external_masked(file, column)?;
+    let frame = options.frame;
+    let to_margemu = |list: &mut Vec<Stamped>| {
+        for s in list.iter_mut() {
+            s.1 = frame.quat_in(s.1);
+        }
+    };
+    to_margemu(&mut rec.reference);
+    if let Some(e) = rec.estimate.as_mut() {
+        to_margemu(e);
+    }
     let rows = rec.imu.t_ns.len();
     let mut inputs = vec![format!("{} ({rows} rows)", file.display())];
     let mut notes = Vec::new();
+    if frame != crate::frame::Frame::Nwu {
+        notes.push(format!(
+            "frame {frame}: the recording's and the estimates' quaternions converted to margemu's NWU as read; Euler angles here and in errors.csv are NWU (ZYX), geodesic, heading and inclination do not depend on the frame"
+        ));
+    }
     if rec.missing_reference > 0 {
         notes.push(format!(
             "{} of {rows} rows have no reference quaternion (empty or NaN): skipped",
@@ -322,7 +337,8 @@ fn load_external(
     }
     let est = match (estimates, rec.estimate) {
         (Some(path), _) => {
-            let e = super::input::read_estimates(path)?;
+            let mut e = super::input::read_estimates(path)?;
+            to_margemu(&mut e);
             inputs.push(format!("{} ({} estimates)", path.display(), e.len()));
             e
         }

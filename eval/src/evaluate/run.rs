@@ -68,6 +68,9 @@ pub enum Mask {
 /// Options of one evaluation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EvalOptions {
+    /// The world frame of an external recording and its estimates ([`crate::frame`]); their
+    /// quaternions are converted into margemu's as they are read.
+    pub frame: crate::frame::Frame,
     /// The rows of an external recording to score (ignored for other sources). An estimate is
     /// scored when the recording row nearest its aligned instant is.
     pub mask: Mask,
@@ -90,6 +93,7 @@ pub struct EvalOptions {
 impl Default for EvalOptions {
     fn default() -> Self {
         Self {
+            frame: crate::frame::Frame::Nwu,
             mask: Mask::All,
             latency: None,
             search: LatencySearch::default(),

@@ -179,8 +179,17 @@ pub fn read(path: &Path, mag_reference: Option<[f64; 3]>) -> Result<Recording, I
 /// first row of its `truth.csv`; of a CSV recording, the reference quaternion `qw..qz` of its
 /// first row (which must have one: the filter starts at that sample).
 pub fn first_true_attitude(input: &Path) -> Result<[f64; 4], InputError> {
+    first_true_attitude_in(input, crate::frame::Frame::Nwu)
+}
+
+/// [`first_true_attitude`] of a CSV recording in `frame` ([`crate::frame`]), in NWU (a run
+/// directory is margemu's own).
+pub fn first_true_attitude_in(
+    input: &Path,
+    frame: crate::frame::Frame,
+) -> Result<[f64; 4], InputError> {
     if input.is_file() {
-        return first_reference(input);
+        return first_reference(input).map(|q| frame.quat_in(q));
     }
     if !input.is_dir() {
         return Err(bad(

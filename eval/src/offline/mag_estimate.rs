@@ -16,6 +16,7 @@
 //! Only the direction matters to the filters; the result is a unit vector.
 
 use super::input::InputError;
+use crate::frame::Frame;
 use margemu_sim::csv_table::Table;
 use nalgebra::{UnitQuaternion, Vector3};
 use std::path::Path;
@@ -97,6 +98,11 @@ fn add(sum: &mut [f64; 3], v: [f64; 3]) {
 /// The estimate from the recording at `path` (see the module docs); reads it up to the end of
 /// its first long enough rest phase.
 pub fn estimate(path: &Path) -> Result<MagEstimate, InputError> {
+    estimate_in(path, Frame::Nwu)
+}
+
+/// [`estimate`] for a recording in `frame` ([`crate::frame`]); the result is in NWU.
+pub fn estimate_in(path: &Path, frame: Frame) -> Result<MagEstimate, InputError> {
     let mut table = Table::open(path)?;
     let t = table.column("t_s")?;
     let acc = table.columns(["ax", "ay", "az"])?;
@@ -169,7 +175,7 @@ pub fn estimate(path: &Path) -> Result<MagEstimate, InputError> {
     };
     let from_attitude = run.world_rows == run.rows;
     let reference = if from_attitude {
-        unit(run.world).ok_or_else(|| bad("no magnetic field"))?
+        unit(frame.world_in(run.world)).ok_or_else(|| bad("no magnetic field"))?
     } else {
         let up = unit(run.acc).ok_or_else(|| bad("no specific force"))?;
         let m = unit(run.mag).ok_or_else(|| bad("no magnetic field"))?;

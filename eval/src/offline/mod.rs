@@ -36,8 +36,10 @@ mod file;
 pub mod input;
 pub mod mag_estimate;
 
-pub use file::{filter_to_file, FilterError, FilterRun};
-pub use input::{first_true_attitude, open, read, InputError, Recording, Samples};
+pub use file::{filter_to_file, filter_to_file_in, FilterError, FilterRun};
+pub use input::{
+    first_true_attitude, first_true_attitude_in, open, read, InputError, Recording, Samples,
+};
 pub use margemu_filters::Initial;
 pub use margemu_sim::filter_params::{
     self as params, FilterKind, FilterParams, ParamError, ParamSpec,

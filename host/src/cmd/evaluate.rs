@@ -68,6 +68,10 @@ pub struct Cmd {
         allow_negative_numbers = true
     )]
     rest_rate: f64,
+    /// The world frame of the external recording and its estimates: nwu (margemu's), enu, or
+    /// ned (body FRD).
+    #[arg(long, default_value = "nwu", requires = "external")]
+    frame: margemu::frame::Frame,
     /// Skip the figures.
     #[arg(long)]
     no_plots: bool,
@@ -135,6 +139,7 @@ impl Cmd {
             (None, None) => Mask::All,
         };
         let options = EvalOptions {
+            frame: self.frame,
             mask,
             latency,
             search: LatencySearch {

@@ -2,6 +2,7 @@
 //! recording and write its estimates (library: `margemu::offline`).
 
 use anyhow::{bail, Context, Result};
+use margemu::frame::Frame;
 use margemu::offline::{self, AttitudeStart, FilterKind, FilterParams, Initial};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -33,6 +34,10 @@ pub struct Cmd {
     /// reference columns qw,qx,qy,qz on its first row).
     #[arg(long, default_value = "first-sample")]
     attitude_start: AttitudeStart,
+    /// The world frame of a CSV recording, of --mag-reference and of the estimates written:
+    /// nwu (margemu's), enu, or ned (body FRD); see the evaluation guide.
+    #[arg(long, default_value = "nwu")]
+    frame: Frame,
     /// The estimates file: t_s,qw,qx,qy,qz,roll,pitch,yaw.
     #[arg(short, long)]
     output: PathBuf,
@@ -40,8 +45,8 @@ pub struct Cmd {
 
 /// The magnetic reference estimated from the recording at `input`, printed with its rows; when
 /// the estimate fails and it was not asked for (`explicit`), the default, with a note.
-fn estimated(input: &std::path::Path, explicit: bool) -> Result<Option<[f64; 3]>> {
-    match offline::mag_estimate::estimate(input) {
+fn estimated(input: &std::path::Path, frame: Frame, explicit: bool) -> Result<Option<[f64; 3]>> {
+    match offline::mag_estimate::estimate_in(input, frame) {
         Ok(e) => {
             println!("{e}");
             Ok(Some(e.reference))
@@ -72,17 +77,38 @@ impl Cmd {
             Some("auto") if self.input.is_dir() => {
                 bail!("--mag-reference auto: estimation applies to a CSV recording; a run directory's reference is its scene's")
             }
-            Some("auto") => estimated(&self.input, true)?,
-            Some(text) => Some(super::parse_vector3("--mag-reference", text)?),
-            None if self.input.is_file() => estimated(&self.input, false)?,
+            Some("auto") => estimated(&self.input, self.frame, true)?,
+            Some(text) => Some(
+                self.frame
+                    .world_in(super::parse_vector3("--mag-reference", text)?),
+            ),
+            None if self.input.is_file() => estimated(&self.input, self.frame, false)?,
             None => None,
         };
         let initial = match self.attitude_start {
             AttitudeStart::FirstSample => Initial::FirstSample,
-            AttitudeStart::Truth => Initial::Attitude(offline::first_true_attitude(&self.input)?),
+            AttitudeStart::Truth => {
+                Initial::Attitude(offline::first_true_attitude_in(&self.input, self.frame)?)
+            }
         };
         let start = Instant::now();
-        let run = offline::filter_to_file(&params, &self.input, reference, initial, &self.output)?;
+        if self.frame != Frame::Nwu && self.input.is_dir() {
+            bail!("--frame {}: a run directory is margemu's own (nwu); the frame applies to a CSV recording", self.frame);
+        }
+        let run = offline::filter_to_file_in(
+            &params,
+            &self.input,
+            reference,
+            initial,
+            &self.output,
+            self.frame,
+        )?;
+        if self.frame != Frame::Nwu {
+            println!(
+                "frame {}: the recording's IMU columns and --mag-reference read in it, the estimates written in it (evaluate them with --frame {})",
+                self.frame, self.frame
+            );
+        }
         let elapsed = start.elapsed();
         for warning in run.warnings() {
             eprintln!("warning: {warning}");
