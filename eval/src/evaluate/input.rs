@@ -262,7 +262,7 @@ pub fn read_external(path: &Path) -> Result<External, ColumnError> {
 
 /// The reference quaternion of a recording's row: `None` when its cells are all empty or one
 /// is `NaN`; an error when partly empty, infinite, not a number or of zero norm.
-fn reference_of(row: &Row<'_>, cols: [usize; 4]) -> Result<Option<Quat>, ColumnError> {
+pub(super) fn reference_of(row: &Row<'_>, cols: [usize; 4]) -> Result<Option<Quat>, ColumnError> {
     let empty = cols.iter().filter(|&&c| row.text(c).is_empty()).count();
     if empty == 4 {
         return Ok(None);
@@ -289,6 +289,17 @@ pub fn read_external_masked(
     path: &Path,
     mask_column: Option<&str>,
 ) -> Result<External, ColumnError> {
+    read_external_rows(path, mask_column, true)
+}
+
+/// [`read_external_masked`]; without `attitudes`, the reference quaternions are checked but
+/// not kept (`reference` stays empty, `reference_rows` is filled) and the estimate columns are
+/// not read, for a reader that streams them from the file.
+pub(super) fn read_external_rows(
+    path: &Path,
+    mask_column: Option<&str>,
+    attitudes: bool,
+) -> Result<External, ColumnError> {
     let table = Table::open(path)?;
     let t = table.column("t_s")?;
     let acc = table.columns(["ax", "ay", "az"])?;
@@ -297,7 +308,7 @@ pub fn read_external_masked(
     let q = table.columns(["qw", "qx", "qy", "qz"])?;
     let mask = mask_column.map(|m| table.column(m)).transpose()?;
     let est_names = ["qw_est", "qx_est", "qy_est", "qz_est"];
-    let est = if est_names.iter().any(|n| table.optional(n).is_some()) {
+    let est = if attitudes && est_names.iter().any(|n| table.optional(n).is_some()) {
         Some(table.columns(est_names)?)
     } else {
         None
@@ -317,7 +328,9 @@ pub fn read_external_masked(
         match reference_of(row, q)? {
             Some(r) => {
                 out.reference_rows.push(out.imu.t_ns.len() - 1);
-                out.reference.push((t_ns, r));
+                if attitudes {
+                    out.reference.push((t_ns, r));
+                }
             }
             None => out.missing_reference += 1,
         }

@@ -4,8 +4,12 @@
 //! A run directory's `truth.csv` and an estimates file stay on disk: one pass here checks them
 //! and gathers the phases (one byte per instant), the median step and the norms (thinned), and
 //! the passes of alignment and scoring read them again, so memory does not grow with the run.
-//! A session's device output and an external recording are read into memory (a session also
-//! keeps its truth's field, for the measured magnetic phase).
+//! A session's device output is read into memory (with its truth's field, for the measured
+//! magnetic phase). An external recording scored against an estimates file is streamed like a
+//! run: its reference and the estimates are read from the files on each pass
+//! (`Series::Recording`, `Series::FramedEstimates`, converted from `--frame` as read), and only
+//! what the phases and masks need is held (instants and IMU vectors, one flag per row); with
+//! estimate columns in the recording instead, its attitudes are held.
 //!
 //! An external recording's rows without a reference quaternion are left out of the truth and
 //! counted; with a [`Mask`], the rows it keeps are counted, and an estimate is scored only when
@@ -22,7 +26,7 @@
 
 use super::align::{fit_clock, TruthFacts};
 use super::device_log::{read_meta, read_sent};
-use super::input::{read_dut_attitude, read_external_masked, DutRow, Imu, VectorRows};
+use super::input::{read_dut_attitude, read_external_rows, DutRow, Imu, VectorRows};
 use super::phase::{classify, classify_marks, Marks, Phase, PhaseRules, PhaseSample};
 use super::quat::{from_euler, geodesic, normalize};
 use super::run::{Clock, EvalError, EvalOptions, LatencyMode, Mask, Norms, Source};
@@ -310,7 +314,9 @@ fn load_external(
         Mask::Column(c) => Some(c.as_str()),
         _ => None,
     };
-    let mut rec = read_external_masked(file, column)?;
+    // With an estimates file, both attitude series are streamed from the files; with estimate
+    // columns, the recording's attitudes are held.
+    let mut rec = read_external_rows(file, column, estimates.is_none())?;
     let frame = options.frame;
     let to_margemu = |list: &mut Vec<Stamped>| {
         for s in list.iter_mut() {
@@ -335,14 +341,41 @@ fn load_external(
             rec.missing_reference
         ));
     }
-    let est = match (estimates, rec.estimate) {
+    if rec.reference_rows.is_empty() {
+        return Err(EvalError::Input {
+            path: file.to_path_buf(),
+            reason: format!("no row has a reference quaternion ({rows} rows)"),
+        });
+    }
+    let (truth, truth_extent, facts, estimates, estimate_extent) = match (estimates, rec.estimate.take()) {
         (Some(path), _) => {
-            let mut e = super::input::read_estimates(path)?;
-            to_margemu(&mut e);
-            inputs.push(format!("{} ({} estimates)", path.display(), e.len()));
-            e
+            let series = Series::FramedEstimates(path.to_path_buf(), frame);
+            let extent = series.extent()?;
+            inputs.push(format!(
+                "{} ({} estimates)",
+                path.display(),
+                extent.map_or(0, |e| e.count)
+            ));
+            let estimate_extent = extent.ok_or_else(|| empty(&inputs, "estimate"))?;
+            let times = || rec.reference_rows.iter().map(|&r| rec.imu.t_ns[r]);
+            let mut median = MedianStep::default();
+            times().for_each(|t| median.add(t));
+            let mut extent = None;
+            times().for_each(|t| Extent::add(&mut extent, t));
+            let truth_extent = extent.ok_or_else(|| empty(&inputs, "truth"))?;
+            let facts = TruthFacts {
+                first_ns: truth_extent.first_ns,
+                median_step_ns: median.median(),
+            };
+            (
+                Series::Recording(file.to_path_buf(), frame),
+                truth_extent,
+                facts,
+                series,
+                estimate_extent,
+            )
         }
-        (None, Some(e)) => e,
+        (None, Some(e)) => in_memory(&inputs, &rec.reference, &e)?,
         (None, None) => {
             return Err(EvalError::Input {
                 path: file.to_path_buf(),
@@ -350,14 +383,6 @@ fn load_external(
             })
         }
     };
-    if rec.reference.is_empty() {
-        return Err(EvalError::Input {
-            path: file.to_path_buf(),
-            reason: format!("no row has a reference quaternion ({rows} rows)"),
-        });
-    }
-    let (truth, truth_extent, facts, estimates, estimate_extent) =
-        in_memory(&inputs, &rec.reference, &est)?;
     let imu = &rec.imu;
     let samples = external_phases(imu, rules);
     let all_phases = classify(&samples, rules, facts.median_step_ns);
