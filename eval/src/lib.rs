@@ -13,5 +13,6 @@
 
 pub mod analysis;
 pub mod evaluate;
+pub mod frame;
 pub mod offline;
 pub mod tune;

@@ -32,6 +32,23 @@
 //! The magnetic reference is the configured world field (not Madgwick's in-filter
 //! `b = (√(hx²+hy²), 0, hz)` compensation), as eq. 25 writes it.
 //!
+//! **Madgwick's original MARG update** ([`GdaNormalization::Xio`]; Madgwick, "An efficient
+//! orientation filter for inertial and inertial/magnetic sensor arrays", x-io report, 2010,
+//! eqs. 43–46, written here from the report's equations): the step is normalised by `‖∇f‖` as
+//! in [`GdaNormalization::Gradient`], and the magnetic reference is not the configured one but
+//! is rebuilt at every update from the measurement, the *magnetic distortion compensation* of
+//! the report's section 3.4: `h = q̂ ⊗ m ⊗ q̂*` (the unit field measurement in the world), then
+//! `b = (√(hx² + hy²), 0, hz)`. Against eq. 25 of the paper (which compares with a fixed
+//! world field `H`), what differs:
+//! - the reference's inclination follows the measurement, so a field whose dip differs from
+//!   the configured one (or drifts) does not pull the tilt, and a magnetic disturbance that
+//!   changes the dip affects only heading;
+//! - the reference has no horizontal direction of its own: heading is taken from magnetic
+//!   north along world +x whatever the configured field's declination (the configured field
+//!   only sets the first-sample TRIAD start);
+//! - no gyroscope bias compensation (the report's `ζ` term of eqs. 47–48 is left out, as in
+//!   its published MARG update).
+//!
 //! Default `β = 0.1` (Madgwick's published default; the paper's "initial" column came from
 //! heuristics).
 //!
@@ -47,7 +64,7 @@
 use crate::filter::{AttitudeFilter, Diagnostics, Imu};
 use crate::init::{parameter, Initial, Shared, DEFAULT_MAG_REFERENCE};
 use crate::quat::{
-    axpy, cross, dot3, mul, normalize, scale, up_in_body, world_to_body, Quat, Vec3,
+    axpy, body_to_world, cross, dot3, mul, normalize, scale, up_in_body, world_to_body, Quat, Vec3,
 };
 use crate::{Error, Real};
 
@@ -59,6 +76,9 @@ pub enum GdaNormalization {
     Gradient,
     /// `β·∇f/‖f‖`, as the paper prints eq. 25.
     Residual,
+    /// Madgwick's original MARG update (x-io report, 2010): `β·∇f/‖∇f‖` with the magnetic
+    /// reference rebuilt from each measurement, `b = (√(hx²+hy²), 0, hz)` (see the module docs).
+    Xio,
 }
 
 /// Parameters of the [`Gda`].
@@ -147,9 +167,16 @@ impl<T: Real> AttitudeFilter<T> for Gda<T> {
             return;
         };
         let q = self.s.q;
-        let (sigma, e) = residual_terms(q, step.acc, step.mag, self.s.mag_ref);
+        let mag_ref = match (self.normalization, step.mag) {
+            (GdaNormalization::Xio, Some(m)) => {
+                let h = body_to_world(q, m);
+                [(h[0] * h[0] + h[1] * h[1]).sqrt(), T::ZERO, h[2]]
+            }
+            _ => self.s.mag_ref,
+        };
+        let (sigma, e) = residual_terms(q, step.acc, step.mag, mag_ref);
         let norm = match self.normalization {
-            GdaNormalization::Gradient => {
+            GdaNormalization::Gradient | GdaNormalization::Xio => {
                 (sigma * sigma + e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt()
             }
             GdaNormalization::Residual => (T::TWO * sigma).sqrt() * T::HALF,

@@ -121,3 +121,53 @@ fn both_normalizations_converge_and_settle_within_their_step() {
     );
     eprintln!("settled: gradient {gradient:.3e} residual {residual:.3e}");
 }
+
+/// A level body at heading 0 in a field of 30° declination, measured exactly: eq. 25 against
+/// that field keeps the heading; Madgwick's original (x-io) update takes heading from magnetic
+/// north along +x whatever the configured field says, so it settles 30° off in yaw, level.
+#[test]
+fn the_original_madgwick_update_ignores_the_fields_declination() {
+    let dec = 30f64.to_radians();
+    let dip = 60f64.to_radians();
+    let field = [dip.cos() * dec.cos(), dip.cos() * dec.sin(), -dip.sin()];
+    let imu = Imu {
+        gyro: [0.0; 3],
+        acc: [0.0, 0.0, 9.80665],
+        mag: field,
+    };
+    let settled = |normalization| {
+        let mut f = Gda::new(&GdaConfig {
+            beta: BETA,
+            normalization,
+            mag_reference: field,
+            initial: Initial::Attitude([1.0, 0.0, 0.0, 0.0]),
+        })
+        .unwrap();
+        for _ in 0..20_000 {
+            f.update(&imu, DT);
+        }
+        margemu_filters::quat::euler_zyx(f.quaternion())
+    };
+    let eq25 = settled(GdaNormalization::Gradient);
+    let xio = settled(GdaNormalization::Xio);
+    assert!(eq25.iter().all(|a| a.abs() < 4.0 * BETA * DT), "{eq25:?}");
+    assert!((xio[2] + dec).abs() < 4.0 * BETA * DT, "{xio:?}");
+    assert!(
+        xio[0].abs() < 4.0 * BETA * DT && xio[1].abs() < 4.0 * BETA * DT,
+        "{xio:?}"
+    );
+}
+
+/// The x-io update converges from a 90° heading error and a tilt, as Gradient does.
+#[test]
+fn the_original_madgwick_update_converges() {
+    let truth = from_euler_zyx([0.2, -0.1, 0.5]);
+    let start = from_euler_zyx([0.0, 0.0, 0.5 + std::f64::consts::FRAC_PI_2]);
+    let imu = static_imu(truth, [0.0; 3]);
+    let mut f = gda(GdaNormalization::Xio, start);
+    for _ in 0..20_000 {
+        f.update(&imu, DT);
+    }
+    let e = geodesic_angle(f.quaternion(), truth);
+    assert!(e < 4.0 * BETA * DT, "{e}");
+}

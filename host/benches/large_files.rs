@@ -4,10 +4,12 @@
 //!
 //! It writes, unless they are already there for the same row count, a run directory with a
 //! `truth.csv` at 1 kHz and an estimates file `t_s,qw,qx,qy,qz` (the truth rolled by 0.01 rad,
-//! 3 ms late), and an external recording `t_s,ax,…,mz` of the same motion; then runs
-//! `margemu evaluate RUN --estimates FILE` (figures included) and `margemu filter --filter ekf
-//! RECORDING -o FILE` one after the other, and prints each one's wall time and peak resident
-//! memory (GNU time's `%M`, the child's `ru_maxrss`; `apt-get install time` if it is missing).
+//! 3 ms late), and an external recording `t_s,ax,…,mz,qw,qx,qy,qz` of the same motion (its
+//! reference attitude last); then runs `margemu evaluate RUN --estimates FILE` (figures
+//! included), `margemu filter --filter ekf RECORDING -o FILE` and `margemu evaluate --external
+//! RECORDING --estimates FILE` (the filter's output, figures included) one after the other, and
+//! prints each one's wall time and peak resident memory (GNU time's `%M`, the child's
+//! `ru_maxrss`; `apt-get install time` if it is missing).
 //!
 //! Environment: `MARGEMU_LARGE_ROWS` (rows, default 10 000 000), `MARGEMU_LARGE_DIR` (where the
 //! files go, default the target's temporary directory), `MARGEMU_BIN` (the binary measured,
@@ -46,7 +48,8 @@ fn write_row(out: &mut impl Write, first: &str, values: &[f64]) -> std::io::Resu
 
 fn generate(dir: &Path, rows: u64) -> std::io::Result<()> {
     let marker = dir.join("rows.txt");
-    if std::fs::read_to_string(&marker).ok().as_deref() == Some(&rows.to_string()) {
+    let stamp = format!("{rows} rows, recording with its reference");
+    if std::fs::read_to_string(&marker).ok().as_deref() == Some(&stamp) {
         println!("reusing the files in {}", dir.display());
         return Ok(());
     }
@@ -62,7 +65,7 @@ fn generate(dir: &Path, rows: u64) -> std::io::Result<()> {
         "t_ns,qw,qx,qy,qz,wx,wy,wz,fx,fy,fz,ax_b,ay_b,az_b,mx,my,mz"
     )?;
     writeln!(est, "t_s,qw,qx,qy,qz")?;
-    writeln!(rec, "t_s,ax,ay,az,gx,gy,gz,mx,my,mz")?;
+    writeln!(rec, "t_s,ax,ay,az,gx,gy,gz,mx,my,mz,qw,qx,qy,qz")?;
     for k in 0..rows {
         let t_ns = k * 1_000_000;
         let t = k as f64 * 1e-3;
@@ -81,13 +84,15 @@ fn generate(dir: &Path, rows: u64) -> std::io::Result<()> {
         let late = euler(t - 0.003);
         let stamp = format!("{}.{:09}", t_ns / 1_000_000_000, t_ns % 1_000_000_000);
         write_row(&mut est, &stamp, &quat([late[0] + 0.01, late[1], late[2]]))?;
-        let imu = [f.x, f.y, f.z, w[0], w[1], w[2], m.x, m.y, m.z];
+        let imu = [
+            f.x, f.y, f.z, w[0], w[1], w[2], m.x, m.y, m.z, q[0], q[1], q[2], q[3],
+        ];
         write_row(&mut rec, &stamp, &imu)?;
     }
     for mut w in [truth, est, rec] {
         w.flush()?;
     }
-    std::fs::write(&marker, rows.to_string())?;
+    std::fs::write(&marker, stamp)?;
     println!(
         "wrote {rows} rows each into {} in {:.1} s",
         dir.display(),
@@ -140,12 +145,13 @@ fn main() {
     let p = |name: &str| dir.join(name).display().to_string();
     let (run, est, rec) = (p("run"), p("estimates.csv"), p("recording.csv"));
     let (out, filtered) = (p("evaluation"), p("filtered.csv"));
+    let external_out = p("external-evaluation");
     println!("binary: {}", bin.display());
     println!(
         "{:<54} {:>10} {:>14}",
         "command", "wall (s)", "peak RSS (MiB)"
     );
-    let cases: [(&str, Vec<&str>); 2] = [
+    let cases: [(&str, Vec<&str>); 3] = [
         (
             "evaluate RUN --estimates estimates.csv --out DIR",
             vec!["evaluate", &run, "--estimates", &est, "--out", &out],
@@ -153,6 +159,18 @@ fn main() {
         (
             "filter --filter ekf recording.csv -o filtered.csv",
             vec!["filter", "--filter", "ekf", &rec, "-o", &filtered],
+        ),
+        (
+            "evaluate --external recording.csv --estimates filtered.csv",
+            vec![
+                "evaluate",
+                "--external",
+                &rec,
+                "--estimates",
+                &filtered,
+                "--out",
+                &external_out,
+            ],
         ),
     ];
     for (name, args) in cases {

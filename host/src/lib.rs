@@ -17,7 +17,7 @@
 //! - [`perf`]: speed-against-error benchmarks behind `margemu bench`.
 #![warn(missing_docs)]
 
-pub use margemu_eval::{analysis, evaluate, offline, tune};
+pub use margemu_eval::{analysis, evaluate, frame, offline, tune};
 pub use margemu_hil::{bus, dut, hitl, loopback, stream, vfc};
 pub use margemu_sim::{
     bench, csv_column, filter_params, guard, input_file, marg, mcap, meta, motion, output, quat,

@@ -103,7 +103,7 @@ fn the_command_line_refuses_bad_parameters_and_writes_nothing() {
     let params = dir.join("p.toml");
     std::fs::write(&params, "[ecf]\nkp = -0.5\n").unwrap();
     let p = params.to_str().unwrap();
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 10] = [
         (
             &["--filter", "ecf", "--params", p],
             "p.toml:2:6: -0.5 is not a finite number ≥ 0",
@@ -114,7 +114,19 @@ fn the_command_line_refuses_bad_parameters_and_writes_nothing() {
         ),
         (
             &["--filter", "gda", "--param", "kp=1"],
-            "gda has no parameter `kp` (it has: beta)",
+            "gda has no parameter `kp` (it has: beta, normalization)",
+        ),
+        (
+            &["--filter", "gda", "--param", "gda.beta=x"],
+            "--param gda.beta=x: `gda.beta=x`: expected NAME=VALUE",
+        ),
+        (
+            &["--filter", "gda", "--param", "gda.normalization=fast"],
+            "--param gda.normalization=fast: `normalization`: `fast` is not gradient, residual or xio",
+        ),
+        (
+            &["--filter", "ekf", "--param", "initial_bias_std=-1"],
+            "--param initial_bias_std=-1: `initial_bias_std`: `-1` is not a finite number > 0",
         ),
         (
             &["--filter", "ekf", "--param", "mag_noise"],
@@ -130,7 +142,7 @@ fn the_command_line_refuses_bad_parameters_and_writes_nothing() {
         ),
         (
             &["--filter", "ecf", "--attitude-start", "truth"],
-            "needs a run directory with truth.csv",
+            "starting from the truth needs the reference columns qw,qx,qy,qz",
         ),
     ];
     for (extra, expected) in cases {

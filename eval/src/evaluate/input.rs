@@ -11,7 +11,11 @@
 //! | `marg.csv` | `t_ns,acc_x..acc_z,mag_x..mag_z` | ns |
 //!
 //! Quaternions are normalised; a zero or non-finite one is an error at its line, except in
-//! `dut_attitude.csv`, where such a row (a device's fault) is skipped and counted.
+//! `dut_attitude.csv`, where such a row (a device's fault) is skipped and counted, and the
+//! reference of an external recording, where a row whose `qw..qz` are all empty or hold a `NaN`
+//! (public recordings mark the instants the optical reference lost the body so) keeps its IMU
+//! sample but has no reference: it is skipped in scoring and counted. An external recording may
+//! name a mask column (any finite number; nonzero: the row is scored).
 
 use super::quat::{normalize, Quat};
 use super::score::Stamped;
@@ -113,10 +117,16 @@ impl DutAttitude {
 /// An external recording: IMU samples, the reference attitude and, optionally, an estimate.
 #[derive(Clone, Debug, Default)]
 pub struct External {
-    /// The IMU columns.
+    /// The IMU columns, every row.
     pub imu: Imu,
-    /// The reference quaternion per row.
+    /// The reference quaternion of each row that has one.
     pub reference: Vec<Stamped>,
+    /// The row (index into `imu`) of each `reference` sample.
+    pub reference_rows: Vec<usize>,
+    /// Rows without a reference (`qw..qz` empty or `NaN`), skipped.
+    pub missing_reference: usize,
+    /// The mask column per row (`true`: nonzero, scored), when one was named.
+    pub mask: Option<Vec<bool>>,
     /// `qw_est..qz_est` per row where they are filled; `None` without those columns.
     pub estimate: Option<Vec<Stamped>>,
 }
@@ -247,20 +257,65 @@ pub fn read_estimates(path: &Path) -> Result<Vec<Stamped>, ColumnError> {
 
 /// Reads an external recording (see the module docs).
 pub fn read_external(path: &Path) -> Result<External, ColumnError> {
+    read_external_masked(path, None)
+}
+
+/// The reference quaternion of a recording's row: `None` when its cells are all empty or one
+/// is `NaN`; an error when partly empty, infinite, not a number or of zero norm.
+pub(super) fn reference_of(row: &Row<'_>, cols: [usize; 4]) -> Result<Option<Quat>, ColumnError> {
+    let empty = cols.iter().filter(|&&c| row.text(c).is_empty()).count();
+    if empty == 4 {
+        return Ok(None);
+    }
+    if empty > 0 {
+        return Err(row.error("qw..qz are partly empty".into()));
+    }
+    let mut raw = [0.0; 4];
+    for (r, &c) in raw.iter_mut().zip(&cols) {
+        *r = row.any_f64(c)?;
+        if r.is_nan() {
+            return Ok(None);
+        }
+        if r.is_infinite() {
+            return Err(row.error(format!("`{}` = {} is not finite", row.name(c), *r)));
+        }
+    }
+    unit(row, raw).map(Some)
+}
+
+/// Reads an external recording with the mask column `mask_column` when given (see the module
+/// docs).
+pub fn read_external_masked(
+    path: &Path,
+    mask_column: Option<&str>,
+) -> Result<External, ColumnError> {
+    read_external_rows(path, mask_column, true)
+}
+
+/// [`read_external_masked`]; without `attitudes`, the reference quaternions are checked but
+/// not kept (`reference` stays empty, `reference_rows` is filled) and the estimate columns are
+/// not read, for a reader that streams them from the file.
+pub(super) fn read_external_rows(
+    path: &Path,
+    mask_column: Option<&str>,
+    attitudes: bool,
+) -> Result<External, ColumnError> {
     let table = Table::open(path)?;
     let t = table.column("t_s")?;
     let acc = table.columns(["ax", "ay", "az"])?;
     let gyr = table.columns(["gx", "gy", "gz"])?;
     let mag = table.columns(["mx", "my", "mz"])?;
     let q = table.columns(["qw", "qx", "qy", "qz"])?;
+    let mask = mask_column.map(|m| table.column(m)).transpose()?;
     let est_names = ["qw_est", "qx_est", "qy_est", "qz_est"];
-    let est = if est_names.iter().any(|n| table.optional(n).is_some()) {
+    let est = if attitudes && est_names.iter().any(|n| table.optional(n).is_some()) {
         Some(table.columns(est_names)?)
     } else {
         None
     };
     let mut out = External {
         estimate: est.map(|_| Vec::new()),
+        mask: mask.map(|_| Vec::new()),
         ..External::default()
     };
     table.for_each(|row| {
@@ -270,7 +325,18 @@ pub fn read_external(path: &Path) -> Result<External, ColumnError> {
         out.imu.acc.push(row.f64s(acc)?);
         out.imu.gyr.push(row.f64s(gyr)?);
         out.imu.mag.push(row.f64s(mag)?);
-        out.reference.push((t_ns, unit(row, row.f64s(q)?)?));
+        match reference_of(row, q)? {
+            Some(r) => {
+                out.reference_rows.push(out.imu.t_ns.len() - 1);
+                if attitudes {
+                    out.reference.push((t_ns, r));
+                }
+            }
+            None => out.missing_reference += 1,
+        }
+        if let (Some(col), Some(list)) = (mask, out.mask.as_mut()) {
+            list.push(row.f64(col)? != 0.0);
+        }
         if let (Some(cols), Some(list)) = (est, out.estimate.as_mut()) {
             let values = cols.map(|c| row.opt_f64(c));
             let mut filled = [0.0; 4];

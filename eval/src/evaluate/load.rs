@@ -4,8 +4,16 @@
 //! A run directory's `truth.csv` and an estimates file stay on disk: one pass here checks them
 //! and gathers the phases (one byte per instant), the median step and the norms (thinned), and
 //! the passes of alignment and scoring read them again, so memory does not grow with the run.
-//! A session's device output and an external recording are read into memory (a session also
-//! keeps its truth's field, for the measured magnetic phase).
+//! A session's device output is read into memory (with its truth's field, for the measured
+//! magnetic phase). An external recording scored against an estimates file is streamed like a
+//! run: its reference and the estimates are read from the files on each pass
+//! (`Series::Recording`, `Series::FramedEstimates`, converted from `--frame` as read), and only
+//! what the phases and masks need is held (instants and IMU vectors, one flag per row); with
+//! estimate columns in the recording instead, its attitudes are held.
+//!
+//! An external recording's rows without a reference quaternion are left out of the truth and
+//! counted; with a [`Mask`], the rows it keeps are counted, and an estimate is scored only when
+//! the recording row nearest its aligned instant has a reference and is kept.
 //!
 //! Time stamps of `dut_attitude.csv` rows, on the scene's axis (ns since scene time 0):
 //! - `host_ns − start_host_ns` (arrival time) by default;
@@ -18,10 +26,10 @@
 
 use super::align::{fit_clock, TruthFacts};
 use super::device_log::{read_meta, read_sent};
-use super::input::{read_dut_attitude, read_external, DutRow, Imu, VectorRows};
+use super::input::{read_dut_attitude, read_external_rows, DutRow, Imu, VectorRows};
 use super::phase::{classify, classify_marks, Marks, Phase, PhaseRules, PhaseSample};
 use super::quat::{from_euler, geodesic, normalize};
-use super::run::{Clock, EvalError, EvalOptions, LatencyMode, Norms, Source};
+use super::run::{Clock, EvalError, EvalOptions, LatencyMode, Mask, Norms, Source};
 use super::score::{ScoreError, Stamped};
 use super::series::{Extent, Series};
 use super::signals::{external_phases, measured_field_deviation, norms};
@@ -42,6 +50,29 @@ pub(super) struct Loaded {
     pub(super) norms: Norms,
     pub(super) clock: Clock,
     pub(super) default_latency: LatencyMode,
+    /// An external recording's rows and which of them are scored.
+    pub(super) rows: Option<ScoredRows>,
+}
+
+/// The instants of a recording's rows and whether each is scored (it has a reference and the
+/// mask keeps it).
+pub(super) struct ScoredRows {
+    t_ns: Vec<u64>,
+    scored: Vec<bool>,
+}
+
+impl ScoredRows {
+    /// Whether the row nearest `t_ns` (the earlier of two equally near) is scored.
+    pub(super) fn scores(&self, t_ns: i64) -> bool {
+        let t = t_ns.max(0) as u64;
+        let after = self.t_ns.partition_point(|&r| r < t);
+        let nearest = match (after.checked_sub(1), self.t_ns.get(after)) {
+            (Some(b), Some(&a)) if a - t < t - self.t_ns[b] => after,
+            (Some(b), _) => b,
+            (None, _) => after,
+        };
+        self.scored.get(nearest).copied().unwrap_or(false)
+    }
 }
 
 /// Reads `source`.
@@ -53,9 +84,7 @@ pub(super) fn load(source: &Source, options: &EvalOptions) -> Result<Loaded, Eva
     let mut loaded = match source {
         Source::Session(dir) => load_session(dir, options),
         Source::Estimates { dir, estimates } => load_run(dir, estimates, &options.rules),
-        Source::External { file, estimates } => {
-            load_external(file, estimates.as_deref(), &options.rules)
-        }
+        Source::External { file, estimates } => load_external(file, estimates.as_deref(), options),
     }?;
     loaded.notes.extend(incomplete);
     Ok(loaded)
@@ -243,6 +272,7 @@ fn load_run(dir: &Path, estimates: &Path, rules: &PhaseRules) -> Result<Loaded, 
         norms: scan.norms,
         clock: Clock::Absent,
         default_latency: LatencyMode::Fixed(0),
+        rows: None,
     })
 }
 
@@ -277,17 +307,75 @@ fn in_memory(
 fn load_external(
     file: &Path,
     estimates: Option<&Path>,
-    rules: &PhaseRules,
+    options: &EvalOptions,
 ) -> Result<Loaded, EvalError> {
-    let rec = read_external(file)?;
-    let mut inputs = vec![format!("{} ({} rows)", file.display(), rec.reference.len())];
-    let est = match (estimates, rec.estimate) {
-        (Some(path), _) => {
-            let e = super::input::read_estimates(path)?;
-            inputs.push(format!("{} ({} estimates)", path.display(), e.len()));
-            e
+    let rules = &options.rules;
+    let column = match &options.mask {
+        Mask::Column(c) => Some(c.as_str()),
+        _ => None,
+    };
+    // With an estimates file, both attitude series are streamed from the files; with estimate
+    // columns, the recording's attitudes are held.
+    let mut rec = read_external_rows(file, column, estimates.is_none())?;
+    let frame = options.frame;
+    let to_margemu = |list: &mut Vec<Stamped>| {
+        for s in list.iter_mut() {
+            s.1 = frame.quat_in(s.1);
         }
-        (None, Some(e)) => e,
+    };
+    to_margemu(&mut rec.reference);
+    if let Some(e) = rec.estimate.as_mut() {
+        to_margemu(e);
+    }
+    let rows = rec.imu.t_ns.len();
+    let mut inputs = vec![format!("{} ({rows} rows)", file.display())];
+    let mut notes = Vec::new();
+    if frame != crate::frame::Frame::Nwu {
+        notes.push(format!(
+            "frame {frame}: the recording's and the estimates' quaternions converted to margemu's NWU as read; Euler angles here and in errors.csv are NWU (ZYX), geodesic, heading and inclination do not depend on the frame"
+        ));
+    }
+    if rec.missing_reference > 0 {
+        notes.push(format!(
+            "{} of {rows} rows have no reference quaternion (empty or NaN): skipped",
+            rec.missing_reference
+        ));
+    }
+    if rec.reference_rows.is_empty() {
+        return Err(EvalError::Input {
+            path: file.to_path_buf(),
+            reason: format!("no row has a reference quaternion ({rows} rows)"),
+        });
+    }
+    let (truth, truth_extent, facts, estimates, estimate_extent) = match (estimates, rec.estimate.take()) {
+        (Some(path), _) => {
+            let series = Series::FramedEstimates(path.to_path_buf(), frame);
+            let extent = series.extent()?;
+            inputs.push(format!(
+                "{} ({} estimates)",
+                path.display(),
+                extent.map_or(0, |e| e.count)
+            ));
+            let estimate_extent = extent.ok_or_else(|| empty(&inputs, "estimate"))?;
+            let times = || rec.reference_rows.iter().map(|&r| rec.imu.t_ns[r]);
+            let mut median = MedianStep::default();
+            times().for_each(|t| median.add(t));
+            let mut extent = None;
+            times().for_each(|t| Extent::add(&mut extent, t));
+            let truth_extent = extent.ok_or_else(|| empty(&inputs, "truth"))?;
+            let facts = TruthFacts {
+                first_ns: truth_extent.first_ns,
+                median_step_ns: median.median(),
+            };
+            (
+                Series::Recording(file.to_path_buf(), frame),
+                truth_extent,
+                facts,
+                series,
+                estimate_extent,
+            )
+        }
+        (None, Some(e)) => in_memory(&inputs, &rec.reference, &e)?,
         (None, None) => {
             return Err(EvalError::Input {
                 path: file.to_path_buf(),
@@ -295,13 +383,39 @@ fn load_external(
             })
         }
     };
-    let (truth, truth_extent, facts, estimates, estimate_extent) =
-        in_memory(&inputs, &rec.reference, &est)?;
     let imu = &rec.imu;
-    let phases = classify(&external_phases(imu, rules), rules, facts.median_step_ns);
+    let samples = external_phases(imu, rules);
+    let all_phases = classify(&samples, rules, facts.median_step_ns);
+    let phases = rec.reference_rows.iter().map(|&r| all_phases[r]).collect();
+    let (kept, rule): (Vec<bool>, String) = match &options.mask {
+        Mask::All => (vec![true; rows], String::new()),
+        Mask::Column(c) => (
+            rec.mask.clone().unwrap_or_default(),
+            format!("column `{c}` nonzero"),
+        ),
+        Mask::Rest(r) => (
+            samples.iter().map(|s| s.rate < *r).collect(),
+            format!("rest: averaged gyro norm below {r} rad/s"),
+        ),
+        Mask::Motion(r) => (
+            samples.iter().map(|s| s.rate >= *r).collect(),
+            format!("motion: averaged gyro norm at or above {r} rad/s"),
+        ),
+    };
+    let mut scored = vec![false; rows];
+    for &r in &rec.reference_rows {
+        scored[r] = kept[r];
+    }
+    if options.mask != Mask::All {
+        notes.push(format!(
+            "mask ({rule}): {} of {rows} rows kept, {} of them with a reference",
+            kept.iter().filter(|&&k| k).count(),
+            scored.iter().filter(|&&k| k).count()
+        ));
+    }
     Ok(Loaded {
         inputs,
-        notes: Vec::new(),
+        notes,
         truth,
         truth_extent,
         facts,
@@ -311,6 +425,10 @@ fn load_external(
         norms: norms("the recording's IMU columns", &imu.t_ns, &imu.acc, &imu.mag),
         clock: Clock::Absent,
         default_latency: LatencyMode::Fixed(0),
+        rows: Some(ScoredRows {
+            t_ns: rec.imu.t_ns,
+            scored,
+        }),
     })
 }
 
@@ -430,6 +548,7 @@ fn load_session(dir: &Path, options: &EvalOptions) -> Result<Loaded, EvalError> 
         norms: scan.norms,
         clock,
         default_latency: LatencyMode::Auto,
+        rows: None,
     })
 }
 

@@ -40,9 +40,12 @@ mod walk;
 pub use align::{estimate_latency, fit_clock, ClockFit, Latency, LatencySearch};
 pub use phase::{Phase, PhaseRules};
 pub use run::{
-    evaluate, evaluate_writing, EvalError, EvalOptions, Evaluation, LatencyMode, Source,
+    evaluate, evaluate_writing, EvalError, EvalOptions, Evaluation, LatencyMode, Mask, Source,
 };
-pub use score::{score, Compared, Estimates, Reference, ScoreError, ScoreOptions, Scores, Stamped};
+pub use score::{
+    heading_inclination, score, Compared, Estimates, Reference, ScoreError, ScoreOptions, Scores,
+    Stamped,
+};
 
 /// Steps whose median is the time step of the first sample (which has no predecessor): those
 /// of the first samples only, so a reader that streams a long recording need not hold it.

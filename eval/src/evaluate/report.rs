@@ -2,12 +2,13 @@
 //! the rules, the figures linked) and `errors.csv` (every scored instant).
 //!
 //! The score table follows the paper's Table 3: rows `F`, `MSE` and `STD` per angle (rad², rad),
-//! then the geodesic RMS and maximum; one column per phase, after the whole run.
+//! then the geodesic RMS and maximum, then BROAD's heading and inclination errors (RMS and
+//! maximum, see [`score`](mod@super::score)); one column per phase, after the whole run.
 //!
 //! `errors.csv` (one row per scored estimate, written as it is scored by
 //! [`evaluate_writing`](super::run::evaluate_writing); `t_ns` its aligned instant in
-//! nanoseconds): `t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic`
-//! (rad; `e = wrap(true − estimate)`).
+//! nanoseconds): `t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic,heading,inclination`
+//! (rad; `e = wrap(true − estimate)`; `heading`, `inclination`: BROAD's split of the error).
 
 use super::phase::Phase;
 use super::run::{Clock, EvalError, Evaluation};
@@ -54,6 +55,14 @@ fn table(eval: &Evaluation) -> (Vec<String>, Vec<TableRow>) {
     rows.push(row("geodesic max (°)".into(), &|s| {
         s.geodesic_max.to_degrees()
     }));
+    for (i, name) in ["heading", "inclination"].iter().enumerate() {
+        rows.push(row(format!("{name} RMS (°)"), &move |s| {
+            s.heading_inclination_rms[i].to_degrees()
+        }));
+        rows.push(row(format!("{name} max (°)"), &move |s| {
+            s.heading_inclination_max[i].to_degrees()
+        }));
+    }
     (header, rows)
 }
 
@@ -83,6 +92,9 @@ pub fn latency_line(eval: &Evaluation) -> String {
 /// One line on the device clock.
 pub fn clock_line(eval: &Evaluation) -> String {
     match &eval.clock {
+        Clock::Absent if eval.recording => {
+            "clock: the estimates' own time stamps, on the recording's (or run's) axis; no device clock to fit".into()
+        }
         Clock::Absent => "clock: no device time stamps (rows stamped with their host arrival time)".into(),
         Clock::Unusable(why) => format!("clock: device time stamps not used: {why}"),
         Clock::Fitted(f, used) => format!(
@@ -142,7 +154,7 @@ pub fn markdown(eval: &Evaluation, dir: &Path, figures: &[PathBuf]) -> String {
     let _ = writeln!(
         md,
         "\n## Scores\n\nEuler errors `e = wrap(true − estimate)` into (−π, π]; `F = ∛(MSE_φ·MSE_θ·MSE_ψ)` (eq. 27); \
-         geodesic `2·acos|⟨q, q̂⟩|`. Warm-up {:.3} s; the truth interpolated (slerp) onto each estimate's aligned instant; N counts estimates.\n",
+         geodesic `2·acos|⟨q, q̂⟩|`; heading and inclination as BROAD splits the error `q̂ ⊗ q⁻¹` (world frame: rotation about the vertical, remaining tilt). Warm-up {:.3} s; the truth interpolated (slerp) onto each estimate's aligned instant; N counts estimates.\n",
         w.warmup_ns as f64 * 1e-9
     );
     let (header, rows) = table(eval);
@@ -191,7 +203,7 @@ pub const FILES: [&str; 6] = [
 
 /// The columns of `errors.csv`.
 pub const ERRORS_HEADER: &str =
-    "t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic";
+    "t_ns,phase,roll,pitch,yaw,roll_est,pitch_est,yaw_est,e_roll,e_pitch,e_yaw,geodesic,heading,inclination";
 
 /// `errors.csv` being written, one scored instant at a time.
 pub(super) struct ErrorsCsv {
@@ -222,9 +234,10 @@ impl ErrorsCsv {
     pub(super) fn row(&mut self, c: &Compared, phase: Option<Phase>) -> Result<(), EvalError> {
         let phase = phase.map_or("", Phase::name);
         let [t, e, r] = [c.truth, c.estimate, c.error];
+        let [h, i] = c.heading_inclination;
         writeln!(
             self.out,
-            "{},{phase},{},{},{},{},{},{},{},{},{},{}",
+            "{},{phase},{},{},{},{},{},{},{},{},{},{},{h},{i}",
             c.t_ns, t[0], t[1], t[2], e[0], e[1], e[2], r[0], r[1], r[2], c.geodesic
         )
         .map_err(|error| EvalError::Write {

@@ -50,9 +50,30 @@ pub enum LatencyMode {
     Fixed(i64),
 }
 
+/// Which rows of an external recording are scored (rows without a reference never are).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Mask {
+    /// Every row.
+    #[default]
+    All,
+    /// Rows whose value in this column is nonzero.
+    Column(String),
+    /// Rows at rest: the gyro norm, averaged over [`PhaseRules::window_ns`] as the phases
+    /// average it, below this rate (rad/s).
+    Rest(f64),
+    /// Rows in motion: that averaged gyro norm at or above this rate (rad/s).
+    Motion(f64),
+}
+
 /// Options of one evaluation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EvalOptions {
+    /// The world frame of an external recording and its estimates ([`crate::frame`]); their
+    /// quaternions are converted into margemu's as they are read.
+    pub frame: crate::frame::Frame,
+    /// The rows of an external recording to score (ignored for other sources). An estimate is
+    /// scored when the recording row nearest its aligned instant is.
+    pub mask: Mask,
     /// `None`: `Auto` for sessions, `Fixed(0)` for estimates and external recordings (offline
     /// filter runs are aligned by construction; their own lag is part of their error).
     pub latency: Option<LatencyMode>,
@@ -72,6 +93,8 @@ pub struct EvalOptions {
 impl Default for EvalOptions {
     fn default() -> Self {
         Self {
+            frame: crate::frame::Frame::Nwu,
+            mask: Mask::All,
             latency: None,
             search: LatencySearch::default(),
             message: None,
@@ -191,6 +214,9 @@ pub struct Traces {
 /// Everything one evaluation found.
 #[derive(Clone, Debug)]
 pub struct Evaluation {
+    /// Whether the estimates came from a recording's or a run's own time axis (an offline
+    /// filter run, an external recording), not from a device's output stamped on arrival.
+    pub recording: bool,
     /// The files read, one line each.
     pub inputs: Vec<String>,
     /// Notes on the input (dropped rows, consistency).
@@ -241,7 +267,14 @@ pub fn evaluate_writing(
     )?;
     let mode = options.latency.unwrap_or(loaded.default_latency);
     let (latency_applied_ns, latency_reason) = match (mode, &latency) {
-        (LatencyMode::Fixed(ns), _) => (ns, "fixed by the caller".to_string()),
+        (LatencyMode::Fixed(ns), _) if options.latency.is_some() => {
+            (ns, "fixed by the caller".to_string())
+        }
+        (LatencyMode::Fixed(ns), _) => (
+            ns,
+            "none: the estimates share the recording's time axis; a search is optional (--latency auto)"
+                .to_string(),
+        ),
         (LatencyMode::Auto, Some(l)) if l.observable => (l.lag_ns, "estimated".to_string()),
         (LatencyMode::Auto, Some(l)) if l.at_edge => (
             0,
@@ -255,6 +288,15 @@ pub fn evaluate_writing(
     };
     let mut errors = errors_csv.map(ErrorsCsv::create).transpose()?;
     let scored = score_pass(&loaded, &opts, errors.as_mut());
+    let mut notes = loaded.notes.clone();
+    if let Ok(s) = &scored {
+        if loaded.rows.is_some() {
+            notes.push(format!(
+                "{} estimates not scored: the recording row nearest their instant is masked out or has no reference",
+                s.skipped
+            ));
+        }
+    }
     let scored = match (scored, errors) {
         (Ok(s), Some(e)) => e.finish().map(|()| s),
         (Ok(s), None) => Ok(s),
@@ -284,8 +326,9 @@ pub fn evaluate_writing(
         .map(|(&p, acc)| (p, acc.scores()))
         .collect();
     Ok(Evaluation {
+        recording: loaded.default_latency != LatencyMode::Auto,
         inputs: loaded.inputs,
-        notes: loaded.notes,
+        notes,
         phases: loaded.phases,
         latency,
         latency_applied_ns,
@@ -302,6 +345,7 @@ pub fn evaluate_writing(
 
 /// What the scoring pass gathered.
 struct Scored {
+    skipped: usize,
     all: Accumulator,
     by_phase: [Accumulator; 3],
     traces: Traces,
@@ -336,6 +380,7 @@ fn score_pass(
     let mut all = Accumulator::default();
     let mut by_phase = [Accumulator::default(); 3];
     let mut walk = Walk::new(&loaded.truth)?;
+    let mut skipped = 0;
     for estimate in loaded.estimates.read()? {
         let (stamp, q) = estimate?;
         let aligned = stamp as i64 - opts.latency_ns;
@@ -346,6 +391,12 @@ fn score_pass(
         let Some(located) = locate(window, base, aligned, max_gap) else {
             continue;
         };
+        if let Some(rows) = &loaded.rows {
+            if !rows.scores(aligned) {
+                skipped += 1;
+                continue;
+            }
+        }
         let c = compared(
             &located,
             euler(&located.q),
@@ -368,6 +419,7 @@ fn score_pass(
     walk.drain(&mut on_read)?;
     let e = &loaded.truth_extent;
     Ok(Scored {
+        skipped,
         all,
         by_phase,
         traces: Traces {

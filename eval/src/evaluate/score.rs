@@ -17,6 +17,17 @@
 //! about its mean (population form, `√(MSE − mean²)`), and the largest `|e|`.
 //! `F = ∛(MSE_φ·MSE_θ·MSE_ψ)` (eq. 27, rad²); the geodesic RMS is `√(Σg²/N)`.
 //!
+//! Heading and inclination errors, as the BROAD benchmark defines them (Laidig et al., "BROAD —
+//! A Benchmark for Robust Inertial Orientation Estimation", Data 6(7) 72, 2021, section 4; its
+//! evaluation code `example_code/broad_utils.py`, `calculateErrorQuatEarth`,
+//! `calculateHeadingError`, `calculateInclinationError`): the error quaternion expressed in the
+//! world (reference) frame, `q_e = q̂ ⊗ q⁻¹` (estimate times inverse truth, both body-to-world),
+//! split into a rotation about the vertical (world z, up) and the remaining tilt. The heading
+//! error is `2·atan(|z_e / w_e|)` and the inclination error `2·acos(√(w_e² + z_e²))`; here both
+//! come from `atan2` (`2·atan2(|z_e|, |w_e|)` and `2·atan2(√(x_e² + y_e²), √(w_e² + z_e²))`,
+//! equal for a unit quaternion, exact for small angles), so `q` and `−q` score the same. Their
+//! RMS (`√(Σh²/N)`, `√(Σι²/N)`) and largest values are reported beside the geodesic.
+//!
 //! Latency: an estimate stamped `t` is taken to describe the truth at `t − latency`.
 //!
 //! ```
@@ -219,7 +230,22 @@ pub(super) fn compared(
         estimate: e,
         error: [0, 1, 2].map(|i| wrap_angle(truth_euler[i] - e[i])),
         geodesic: geodesic(&located.q, q),
+        heading_inclination: heading_inclination(&located.q, q),
     }
+}
+
+/// The heading and inclination errors (rad) of `estimate` against `truth`, as BROAD defines
+/// them (see the module docs): the error quaternion `estimate ⊗ truth⁻¹` in the world frame,
+/// its rotation about world z and its remaining tilt.
+pub fn heading_inclination(
+    truth: &UnitQuaternion<f64>,
+    estimate: &UnitQuaternion<f64>,
+) -> [f64; 2] {
+    let e = estimate * truth.inverse();
+    let (w, x, y, z) = (e.w, e.i, e.j, e.k);
+    let heading = 2.0 * z.abs().atan2(w.abs());
+    let inclination = 2.0 * (x * x + y * y).sqrt().atan2((w * w + z * z).sqrt());
+    [heading, inclination]
 }
 
 /// Whether an estimate's aligned instant is late enough to score (after the warm-up).
@@ -282,6 +308,8 @@ pub struct Compared {
     pub error: [f64; 3],
     /// Geodesic angle between truth and estimate (rad).
     pub geodesic: f64,
+    /// Heading and inclination errors `[h, ι]` (rad, BROAD's split; see the module docs).
+    pub heading_inclination: [f64; 2],
 }
 
 impl Reference {

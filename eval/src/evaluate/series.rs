@@ -1,13 +1,16 @@
 //! Attitude series that an evaluation reads from the start as often as it needs (once to count,
-//! once per alignment and scoring pass), one row in memory at a time: a `truth.csv` or an
-//! estimates file on disk, or samples already in memory (sessions, external recordings). Files
+//! once per alignment and scoring pass), one row in memory at a time: a `truth.csv`, an
+//! estimates file or an external recording's reference on disk (the last two in a named world
+//! frame, converted as read; a recording's rows without a reference passed over), or samples
+//! already in memory (sessions, recordings with estimate columns). Files
 //! are checked as they are read (order, quaternions), each fault at its line, as
 //! [`input`](super::input) does.
 
-use super::input::{check_seconds_order, seconds_to_ns, unit};
+use super::input::{check_seconds_order, reference_of, seconds_to_ns, unit};
 use super::quat::normalize;
 use super::run::EvalError;
 use super::score::{validated, Sample, ScoreError, Span, Stamped};
+use crate::frame::Frame;
 use margemu_sim::csv_table::Table;
 use std::path::PathBuf;
 
@@ -18,6 +21,11 @@ pub(super) enum Series {
     Truth(PathBuf),
     /// An estimates file (`t_s`, `qw..qz`; seconds from the scene start).
     Estimates(PathBuf),
+    /// An estimates file in a named world frame, converted as read.
+    FramedEstimates(PathBuf, Frame),
+    /// An external recording's reference (`t_s`, `qw..qz`) in a named world frame, converted
+    /// as read; rows without one (empty or `NaN`) are passed over.
+    Recording(PathBuf, Frame),
     /// Validated samples.
     Memory(Vec<Sample>),
 }
@@ -65,9 +73,17 @@ impl Series {
     pub(super) fn read(&self) -> Result<Reader<'_>, EvalError> {
         Ok(Reader(match self {
             Self::Memory(samples) => Inner::Memory(samples.iter()),
-            Self::Truth(path) | Self::Estimates(path) => {
+            Self::Truth(path)
+            | Self::Estimates(path)
+            | Self::FramedEstimates(path, _)
+            | Self::Recording(path, _) => {
                 let table = Table::open(path)?;
-                let seconds = matches!(self, Self::Estimates(_));
+                let seconds = !matches!(self, Self::Truth(_));
+                let (frame, recording) = match self {
+                    Self::FramedEstimates(_, f) => (*f, false),
+                    Self::Recording(_, f) => (*f, true),
+                    _ => (Frame::Nwu, false),
+                };
                 let t = table.column(if seconds { "t_s" } else { "t_ns" })?;
                 let q = table.columns(["qw", "qx", "qy", "qz"])?;
                 Inner::Csv {
@@ -76,6 +92,8 @@ impl Series {
                     q,
                     seconds,
                     last: None,
+                    frame,
+                    recording,
                 }
             }
         }))
@@ -102,6 +120,8 @@ enum Inner<'a> {
         q: [usize; 4],
         seconds: bool,
         last: Option<u64>,
+        frame: Frame,
+        recording: bool,
     },
 }
 
@@ -117,7 +137,9 @@ impl Iterator for Reader<'_> {
                 q,
                 seconds,
                 last,
-            } => {
+                frame,
+                recording,
+            } => loop {
                 let row = match table.next_row() {
                     Ok(Some(row)) => row,
                     Ok(None) => return None,
@@ -134,16 +156,33 @@ impl Iterator for Reader<'_> {
                         t_ns
                     };
                     // Normalised as the file readers do, then as the scoring functions do.
-                    let q = unit(&row, row.f64s(*q)?)?;
+                    let q = if *recording {
+                        match reference_of(&row, *q)? {
+                            Some(q) => q,
+                            None => return Ok(None),
+                        }
+                    } else {
+                        unit(&row, row.f64s(*q)?)?
+                    };
+                    let q = frame.quat_in(q);
                     let q = normalize(q)
                         .ok_or_else(|| row.error(format!("quaternion {q:?} has no direction")))?;
-                    Ok((t_ns, q))
+                    Ok(Some((t_ns, q)))
                 })();
-                if let Ok((t_ns, _)) = sample {
-                    *last = Some(t_ns);
+                match sample {
+                    Ok(Some(s)) => {
+                        *last = Some(s.0);
+                        return Some(Ok(s));
+                    }
+                    // A recording's row without a reference still orders the time column.
+                    Ok(None) => {
+                        if let Ok(t_ns) = seconds_to_ns(&row, *t) {
+                            *last = Some(t_ns);
+                        }
+                    }
+                    Err(e) => return Some(Err(EvalError::Column(e))),
                 }
-                Some(sample.map_err(EvalError::Column))
-            }
+            },
         }
     }
 }

@@ -28,6 +28,10 @@ pub struct Scores {
     pub geodesic_rms: f64,
     /// Largest geodesic angle (rad).
     pub geodesic_max: f64,
+    /// RMS of the heading and inclination errors `[h, ι]` (rad, BROAD's split).
+    pub heading_inclination_rms: [f64; 2],
+    /// Largest heading and inclination errors (rad).
+    pub heading_inclination_max: [f64; 2],
 }
 
 impl Scores {
@@ -52,6 +56,8 @@ pub struct Accumulator {
     max_abs: [f64; 3],
     geodesic_sq: f64,
     geodesic_max: f64,
+    split_sq: [f64; 2],
+    split_max: [f64; 2],
 }
 
 impl Accumulator {
@@ -69,6 +75,10 @@ impl Accumulator {
         }
         self.geodesic_sq += c.geodesic * c.geodesic;
         self.geodesic_max = self.geodesic_max.max(c.geodesic);
+        for (i, &e) in c.heading_inclination.iter().enumerate() {
+            self.split_sq[i] += e * e;
+            self.split_max[i] = self.split_max[i].max(e);
+        }
     }
 
     /// The scores so far; `None` before the first instant.
@@ -89,6 +99,8 @@ impl Accumulator {
             f: (angles[0].mse * angles[1].mse * angles[2].mse).cbrt(),
             geodesic_rms: (self.geodesic_sq / nf).sqrt(),
             geodesic_max: self.geodesic_max,
+            heading_inclination_rms: self.split_sq.map(|s| (s / nf).sqrt()),
+            heading_inclination_max: self.split_max,
         })
     }
 }

@@ -10,6 +10,7 @@
 use super::input::{open, InputError, Sample};
 use super::{write_estimate, FilterParams, ParamError, ESTIMATE_COLUMNS};
 use crate::evaluate::{first_step_s, FIRST_STEP_WINDOW};
+use crate::frame::Frame;
 use margemu_filters::Initial;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -76,6 +77,20 @@ pub fn filter_to_file(
     initial: Initial,
     output: &Path,
 ) -> Result<FilterRun, FilterError> {
+    filter_to_file_in(params, input, mag_reference, initial, output, Frame::Nwu)
+}
+
+/// [`filter_to_file`] for a recording in `frame` ([`crate::frame`]): its IMU columns are
+/// converted into margemu's axes as they are read and the estimates written back in `frame`;
+/// `mag_reference` and `initial` are already margemu's (NWU).
+pub fn filter_to_file_in(
+    params: &FilterParams,
+    input: &Path,
+    mag_reference: Option<[f64; 3]>,
+    initial: Initial,
+    output: &Path,
+    frame: Frame,
+) -> Result<FilterRun, FilterError> {
     let mut samples = open(input, mag_reference)?;
     let first = samples.first_sample()?;
     let mut filter = params.build(samples.mag_reference, initial)?;
@@ -104,13 +119,14 @@ pub fn filter_to_file(
     let mut previous: Option<u64> = None;
     let mut step = |s: Sample, out: &mut BufWriter<std::fs::File>| {
         let (t_ns, acc, gyro, mag) = s;
+        let (acc, gyro, mag) = (frame.body_in(acc), frame.body_in(gyro), frame.body_in(mag));
         let dt = previous.map_or(first_step, |p| (t_ns - p) as f64 * 1e-9);
         previous = Some(t_ns);
         run.samples += 1;
         run.zero_acc += usize::from(acc == [0.0; 3]);
         run.zero_mag += usize::from(mag == [0.0; 3]);
         filter.update(&margemu_filters::Imu { gyro, acc, mag }, dt);
-        write_estimate(out, &mut float, t_ns, filter.quaternion())
+        write_estimate(out, &mut float, t_ns, frame.quat_out(filter.quaternion()))
     };
     let result = std::thread::scope(|scope| {
         // Parsing on a second thread, in batches (a few in flight), while this one filters and

@@ -175,19 +175,64 @@ pub fn read(path: &Path, mag_reference: Option<[f64; 3]>) -> Result<Recording, I
     })
 }
 
-/// The true attitude at the first sample of a run directory (`truth.csv`), to start a filter
-/// there.
-pub fn first_true_attitude(dir: &Path) -> Result<[f64; 4], InputError> {
-    if !dir.is_dir() {
+/// The true attitude at the first sample, to start a filter there: of a run directory, the
+/// first row of its `truth.csv`; of a CSV recording, the reference quaternion `qw..qz` of its
+/// first row (which must have one: the filter starts at that sample).
+pub fn first_true_attitude(input: &Path) -> Result<[f64; 4], InputError> {
+    first_true_attitude_in(input, crate::frame::Frame::Nwu)
+}
+
+/// [`first_true_attitude`] of a CSV recording in `frame` ([`crate::frame`]), in NWU (a run
+/// directory is margemu's own).
+pub fn first_true_attitude_in(
+    input: &Path,
+    frame: crate::frame::Frame,
+) -> Result<[f64; 4], InputError> {
+    if input.is_file() {
+        return first_reference(input).map(|q| frame.quat_in(q));
+    }
+    if !input.is_dir() {
         return Err(bad(
-            dir,
-            "starting from the truth needs a run directory with truth.csv",
+            input,
+            "starting from the truth needs a run directory with truth.csv, or a CSV recording with qw,qx,qy,qz",
         ));
     }
-    let path = dir.join("truth.csv");
+    let path = input.join("truth.csv");
     read_first_attitude(&path)?
         .map(|s| s.1)
         .ok_or_else(|| bad(&path, "no samples"))
+}
+
+/// The reference quaternion of the first row of the CSV recording at `path`, normalised.
+fn first_reference(path: &Path) -> Result<[f64; 4], InputError> {
+    let mut table = margemu_sim::csv_table::Table::open(path)?;
+    let q = ["qw", "qx", "qy", "qz"].map(|n| table.optional(n));
+    let Some(cols) = q
+        .iter()
+        .all(Option::is_some)
+        .then(|| q.map(Option::unwrap_or_default))
+    else {
+        return Err(bad(
+            path,
+            "starting from the truth needs the reference columns qw,qx,qy,qz (this recording has none)",
+        ));
+    };
+    let Some(row) = table.next_row()? else {
+        return Err(bad(path, "no samples"));
+    };
+    let mut raw = [0.0; 4];
+    for (r, c) in raw.iter_mut().zip(cols) {
+        *r = row.opt_f64(c)?.ok_or_else(|| {
+            row.error("the first row has no reference quaternion to start from (empty); start from first-sample".into())
+        })?;
+    }
+    let n = raw.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if n < 1e-9 {
+        return Err(row
+            .error(format!("quaternion {raw:?} has no direction (zero norm)"))
+            .into());
+    }
+    Ok(raw.map(|x| x / n))
 }
 
 /// The `[field] reference` of the scene text in the `meta.toml` of the run in `dir`.

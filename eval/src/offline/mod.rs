@@ -4,6 +4,7 @@
 //! - [`params`] (`margemu_sim::filter_params`, re-exported): which filter ([`FilterKind`]), its
 //!   tunable parameters ([`FilterParams`]) and the parameters file;
 //! - [`input`]: a `simulate` run directory or an external CSV recording, read into samples;
+//! - [`mag_estimate`]: an external recording's magnetic reference from its first rest phase;
 //! - [`run`]: the filter over the samples, one estimate per sample stamped with its instant
 //!   (the filter's `dt` from the stamps, through `evaluate::estimate_with`), in `f64`;
 //! - [`filter_to_file`]: the filter from a recording on disk to an estimates file, one sample
@@ -33,9 +34,12 @@
 
 mod file;
 pub mod input;
+pub mod mag_estimate;
 
-pub use file::{filter_to_file, FilterError, FilterRun};
-pub use input::{first_true_attitude, open, read, InputError, Recording, Samples};
+pub use file::{filter_to_file, filter_to_file_in, FilterError, FilterRun};
+pub use input::{
+    first_true_attitude, first_true_attitude_in, open, read, InputError, Recording, Samples,
+};
 pub use margemu_filters::Initial;
 pub use margemu_sim::filter_params::{
     self as params, FilterKind, FilterParams, ParamError, ParamSpec,

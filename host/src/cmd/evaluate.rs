@@ -3,7 +3,7 @@
 
 use anyhow::{bail, Result};
 use margemu::evaluate::{
-    report, EvalOptions, LatencyMode, LatencySearch, PhaseRules, ScoreOptions, Source,
+    report, EvalOptions, LatencyMode, LatencySearch, Mask, PhaseRules, ScoreOptions, Source,
 };
 use std::path::PathBuf;
 
@@ -53,6 +53,25 @@ pub struct Cmd {
     /// Averaging window of measured signals for the phases (ms).
     #[arg(long, default_value_t = 100.0)]
     window: f64,
+    /// Score only the external recording's rows whose value in this column is nonzero.
+    #[arg(long, requires = "external", conflicts_with = "mask")]
+    mask_column: Option<String>,
+    /// Score only the external recording's rows at rest or in motion: the gyro norm, averaged
+    /// over --window as the phases are, below (rest) or at or above (motion) --rest-rate.
+    #[arg(long, requires = "external", value_parser = ["rest", "motion"])]
+    mask: Option<String>,
+    /// The rate (rad/s) that separates rest from motion for --mask.
+    #[arg(
+        long,
+        default_value_t = 0.05,
+        requires = "mask",
+        allow_negative_numbers = true
+    )]
+    rest_rate: f64,
+    /// The world frame of the external recording and its estimates: nwu (margemu's), enu, or
+    /// ned (body FRD).
+    #[arg(long, default_value = "nwu", requires = "external")]
+    frame: margemu::frame::Frame,
     /// Skip the figures.
     #[arg(long)]
     no_plots: bool,
@@ -107,7 +126,21 @@ impl Cmd {
                 _ => bail!("--latency must be `auto` or a number of ms, not {text:?}"),
             },
         };
+        if !(self.rest_rate.is_finite() && self.rest_rate > 0.0) {
+            bail!(
+                "--rest-rate must be a finite rate > 0 (rad/s), not {}",
+                self.rest_rate
+            );
+        }
+        let mask = match (self.mask.as_deref(), self.mask_column) {
+            (Some("rest"), _) => Mask::Rest(self.rest_rate),
+            (Some(_), _) => Mask::Motion(self.rest_rate),
+            (None, Some(column)) => Mask::Column(column),
+            (None, None) => Mask::All,
+        };
         let options = EvalOptions {
+            frame: self.frame,
+            mask,
             latency,
             search: LatencySearch {
                 max_lag_ns: ms_to_ns("max-lag", self.max_lag)?,

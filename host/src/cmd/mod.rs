@@ -196,3 +196,19 @@ impl Command {
         }
     }
 }
+
+/// Three numbers `X,Y,Z` (spaces around each allowed: `"-0.36, 0, -0.93"`), finite, for the
+/// option `option`; the error names it and says what it got.
+pub fn parse_vector3(option: &str, text: &str) -> Result<[f64; 3]> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let numbers: Option<Vec<f64>> = parts
+        .iter()
+        .map(|p| p.parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect();
+    match numbers.as_deref() {
+        Some(&[x, y, z]) => Ok([x, y, z]),
+        _ => anyhow::bail!(
+            "{option} needs three finite numbers X,Y,Z (e.g. 0.36,0,-0.93), not {text:?}"
+        ),
+    }
+}

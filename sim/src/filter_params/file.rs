@@ -1,6 +1,7 @@
 //! The parameters file: one table per filter (`[ecf]`, `[gda]`, `[ekf]`), each key optional,
-//! values finite numbers ≥ 0; unknown tables and keys are errors at their line and column (see
-//! [`super`]).
+//! values finite numbers ≥ 0 (the GDA's `normalization` a name); unknown tables and keys are
+//! errors at their line and column (see [`super`]). Settings are written only when they differ
+//! from the defaults, so a tuner's file stays as it was.
 
 use super::{FilterKind, FilterParams, ParamError};
 use crate::scene::SceneError;
@@ -14,6 +15,24 @@ impl FilterParams {
         for (p, v) in self.iter() {
             out.push_str(&format!("{} = {v:?}\n", p.name));
         }
+        let (set, default) = (self.settings(), super::Settings::default());
+        match self.kind() {
+            FilterKind::Gda if set.normalization != default.normalization => {
+                let name = super::normalization_name(set.normalization);
+                out.push_str(&format!("normalization = \"{name}\"\n"));
+            }
+            FilterKind::Ekf => {
+                if set.initial_attitude_std != default.initial_attitude_std {
+                    let v = set.initial_attitude_std;
+                    out.push_str(&format!("initial_attitude_std = {v:?}\n"));
+                }
+                if set.initial_bias_std != default.initial_bias_std {
+                    let v = set.initial_bias_std;
+                    out.push_str(&format!("initial_bias_std = {v:?}\n"));
+                }
+            }
+            _ => {}
+        }
         out
     }
 
@@ -24,9 +43,9 @@ impl FilterParams {
         let file: ParamsFile = toml::from_str(text)
             .map_err(|e| ParamError::File(SceneError::from_toml(path, text, &e)))?;
         let table = match kind {
-            FilterKind::Ecf => file.ecf.map(|t| vec![("kp", t.kp), ("ki", t.ki)]),
-            FilterKind::Gda => file.gda.map(|t| vec![("beta", t.beta)]),
-            FilterKind::Ekf => file.ekf.map(|t| {
+            FilterKind::Ecf => file.ecf.as_ref().map(|t| vec![("kp", t.kp), ("ki", t.ki)]),
+            FilterKind::Gda => file.gda.as_ref().map(|t| vec![("beta", t.beta)]),
+            FilterKind::Ekf => file.ekf.as_ref().map(|t| {
                 vec![
                     ("gyro_noise", t.gyro_noise),
                     ("gyro_bias_walk", t.gyro_bias_walk),
@@ -39,6 +58,31 @@ impl FilterParams {
         for (name, value) in table.unwrap_or_default() {
             if let Some(Gain(v)) = value {
                 params.set(name, v)?;
+            }
+        }
+        let settings: Vec<(&str, Option<String>)> = match (kind, &file.gda, &file.ekf) {
+            (FilterKind::Gda, Some(t), _) => vec![("normalization", t.normalization.clone())],
+            (FilterKind::Ekf, _, Some(t)) => vec![
+                (
+                    "initial_attitude_std",
+                    t.initial_attitude_std.map(|g| g.0.to_string()),
+                ),
+                (
+                    "initial_bias_std",
+                    t.initial_bias_std.map(|g| g.0.to_string()),
+                ),
+            ],
+            _ => Vec::new(),
+        };
+        for (name, value) in settings {
+            if let Some(text) = value {
+                params.set_setting(name, &text).map_err(|e| match e {
+                    ParamError::Setting { name, reason } => ParamError::Setting {
+                        name,
+                        reason: format!("{reason} (in {})", path.display()),
+                    },
+                    other => other,
+                })?;
             }
         }
         Ok(params)
@@ -81,6 +125,7 @@ struct EcfTable {
 #[serde(deny_unknown_fields)]
 struct GdaTable {
     beta: Option<Gain>,
+    normalization: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -90,6 +135,8 @@ struct EkfTable {
     gyro_bias_walk: Option<Gain>,
     accel_noise: Option<Gain>,
     mag_noise: Option<Gain>,
+    initial_attitude_std: Option<Gain>,
+    initial_bias_std: Option<Gain>,
 }
 
 #[cfg(test)]
@@ -106,6 +153,17 @@ mod tests {
             }
             let back = FilterParams::from_toml(&p.to_toml(), Path::new("x.toml"), kind).unwrap();
             assert_eq!(back, p, "{kind}");
+            for name in super::super::setting_names(kind) {
+                let value = if *name == "normalization" {
+                    "xio"
+                } else {
+                    "0.25"
+                };
+                p.set_setting(name, value).unwrap();
+            }
+            let text = p.to_toml();
+            let back = FilterParams::from_toml(&text, Path::new("x.toml"), kind).unwrap();
+            assert_eq!(back, p, "{kind}: {text}");
             assert!(p.build([0.5, 0.0, -0.83], Initial::FirstSample).is_ok());
         }
     }

@@ -2,9 +2,11 @@
 //! `kp`, `ki`; GDA: `beta`; EKF: its four noise statistics), their defaults (the filters
 //! crate's), the range a tuner searches, and the TOML file that carries tuned values.
 //!
-//! Every other setting of a filter keeps the `margemu-filters` default (the GDA's Madgwick
-//! normalization, the EKF's initial standard deviations, the start from the first sample); the
-//! magnetic reference comes from the recording.
+//! The other settings of a filter, not tuned but settable ([`Settings`], by `--param` and in
+//! the file, default the `margemu-filters` ones): the GDA's `normalization` (`gradient`,
+//! `residual` or `xio`, see `margemu_filters::gda`) and the EKF's `initial_attitude_std` and
+//! `initial_bias_std`. The magnetic reference and the start have options of their own. A name
+//! may carry its filter as a prefix (`gda.beta`).
 //!
 //! A parameters file has one table per filter, each key optional (absent keys keep their
 //! default), so one file can hold the tuned values of all three:
@@ -31,7 +33,9 @@
 //! ```
 
 use crate::scene::SceneError;
-use margemu_filters::{AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, Initial};
+use margemu_filters::{
+    AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, GdaNormalization, Initial,
+};
 use std::fmt;
 use std::str::FromStr;
 
@@ -134,6 +138,64 @@ pub struct FilterParams {
     kind: FilterKind,
     /// In the order of `kind.params()`.
     values: Vec<f64>,
+    /// The settings that are not tuned.
+    settings: Settings,
+}
+
+/// A filter's settings that tuners leave alone (see the module docs); each applies to one
+/// filter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// GDA: what the gradient step is divided by (`normalization`).
+    pub normalization: GdaNormalization,
+    /// EKF: initial standard deviation of each quaternion component (`initial_attitude_std`).
+    pub initial_attitude_std: f64,
+    /// EKF: initial standard deviation of each gyro bias component, rad/s (`initial_bias_std`).
+    pub initial_bias_std: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        let ekf = EkfConfig::default();
+        Self {
+            normalization: GdaConfig::default().normalization,
+            initial_attitude_std: ekf.initial_attitude_std,
+            initial_bias_std: ekf.initial_bias_std,
+        }
+    }
+}
+
+/// The names of the settings of `kind`.
+pub fn setting_names(kind: FilterKind) -> &'static [&'static str] {
+    match kind {
+        FilterKind::Ecf => &[],
+        FilterKind::Gda => &["normalization"],
+        FilterKind::Ekf => &["initial_attitude_std", "initial_bias_std"],
+    }
+}
+
+/// The name of a GDA normalization, as `--param normalization=` spells it.
+pub fn normalization_name(n: GdaNormalization) -> &'static str {
+    match n {
+        GdaNormalization::Gradient => "gradient",
+        GdaNormalization::Residual => "residual",
+        GdaNormalization::Xio => "xio",
+    }
+}
+
+/// The GDA normalization named `text`.
+pub fn parse_normalization(text: &str) -> Result<GdaNormalization, ParamError> {
+    [
+        GdaNormalization::Gradient,
+        GdaNormalization::Residual,
+        GdaNormalization::Xio,
+    ]
+    .into_iter()
+    .find(|n| normalization_name(*n) == text)
+    .ok_or_else(|| ParamError::Setting {
+        name: "normalization",
+        reason: format!("`{text}` is not gradient, residual or xio"),
+    })
 }
 
 /// A parameter name or value that was refused.
@@ -157,6 +219,13 @@ pub enum ParamError {
     },
     /// `{0}`: expected NAME=VALUE
     Syntax(String),
+    /// `{name}`: {reason}
+    Setting {
+        /// The setting.
+        name: &'static str,
+        /// Why the value was refused.
+        reason: String,
+    },
     /// {0}
     File(SceneError),
     /// {0}
@@ -169,6 +238,67 @@ impl FilterParams {
         Self {
             kind,
             values: kind.params().iter().map(|p| p.default).collect(),
+            settings: Settings::default(),
+        }
+    }
+
+    /// The settings that are not tuned.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Sets the setting `name` of this filter from its text (see the module docs).
+    pub fn set_setting(&mut self, name: &str, text: &str) -> Result<(), ParamError> {
+        let std = |name: &'static str| -> Result<f64, ParamError> {
+            match text.parse::<f64>() {
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+                _ => Err(ParamError::Setting {
+                    name,
+                    reason: format!("`{text}` is not a finite number > 0"),
+                }),
+            }
+        };
+        match (self.kind, name) {
+            (FilterKind::Gda, "normalization") => {
+                self.settings.normalization = parse_normalization(text)?;
+            }
+            (FilterKind::Ekf, "initial_attitude_std") => {
+                self.settings.initial_attitude_std = std("initial_attitude_std")?;
+            }
+            (FilterKind::Ekf, "initial_bias_std") => {
+                self.settings.initial_bias_std = std("initial_bias_std")?;
+            }
+            _ => return Err(self.unknown(name)),
+        }
+        Ok(())
+    }
+
+    /// `NAME=VALUE` of every parameter, then of every setting, of this filter (what a run used).
+    pub fn assignments(&self) -> Vec<String> {
+        let mut out: Vec<String> = self
+            .iter()
+            .map(|(p, v)| format!("{}={v}", p.name))
+            .collect();
+        for name in setting_names(self.kind) {
+            let value = match *name {
+                "normalization" => normalization_name(self.settings.normalization).to_owned(),
+                "initial_attitude_std" => self.settings.initial_attitude_std.to_string(),
+                _ => self.settings.initial_bias_std.to_string(),
+            };
+            out.push(format!("{name}={value}"));
+        }
+        out
+    }
+
+    fn unknown(&self, name: &str) -> ParamError {
+        let specs = self.kind.params().iter().map(|p| p.name);
+        ParamError::Unknown {
+            kind: self.kind,
+            name: name.to_owned(),
+            names: specs
+                .chain(setting_names(self.kind).iter().copied())
+                .collect::<Vec<_>>()
+                .join(", "),
         }
     }
 
@@ -198,11 +328,7 @@ impl FilterParams {
         let i = specs
             .iter()
             .position(|p| p.name == name)
-            .ok_or_else(|| ParamError::Unknown {
-                kind: self.kind,
-                name: name.to_owned(),
-                names: specs.iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
-            })?;
+            .ok_or_else(|| self.unknown(name))?;
         if !(value.is_finite() && value >= 0.0) {
             return Err(ParamError::Value {
                 name: specs[i].name,
@@ -213,12 +339,19 @@ impl FilterParams {
         Ok(())
     }
 
-    /// Sets a parameter from `NAME=VALUE` (the command line's `--param`).
+    /// Sets a parameter or a setting from `NAME=VALUE` (the command line's `--param`); `NAME`
+    /// may carry the filter as a prefix (`gda.beta=0.2`).
     pub fn set_assignment(&mut self, text: &str) -> Result<(), ParamError> {
         let syntax = || ParamError::Syntax(text.to_owned());
         let (name, value) = text.split_once('=').ok_or_else(syntax)?;
-        let value: f64 = value.trim().parse().map_err(|_| syntax())?;
-        self.set(name.trim(), value)
+        let (name, value) = (name.trim(), value.trim());
+        let prefix = format!("{}.", self.kind);
+        let name = name.strip_prefix(prefix.as_str()).unwrap_or(name);
+        if setting_names(self.kind).contains(&name) {
+            return self.set_setting(name, value);
+        }
+        let value: f64 = value.parse().map_err(|_| syntax())?;
+        self.set(name, value)
     }
 
     /// A filter in `f64` with these parameters, the magnetic reference `mag_reference` (world
@@ -239,9 +372,9 @@ impl FilterParams {
             .map(|f| Box::new(f) as _),
             FilterKind::Gda => Gda::new(&GdaConfig {
                 beta: v("beta"),
+                normalization: self.settings.normalization,
                 mag_reference,
                 initial,
-                ..GdaConfig::default()
             })
             .map(|f| Box::new(f) as _),
             FilterKind::Ekf => Ekf::new(&EkfConfig {
@@ -249,9 +382,10 @@ impl FilterParams {
                 gyro_bias_walk: v("gyro_bias_walk"),
                 accel_noise: v("accel_noise"),
                 mag_noise: v("mag_noise"),
+                initial_attitude_std: self.settings.initial_attitude_std,
+                initial_bias_std: self.settings.initial_bias_std,
                 mag_reference,
                 initial,
-                ..EkfConfig::default()
             })
             .map(|f| Box::new(f) as _),
         };
@@ -298,10 +432,35 @@ mod tests {
         p.set_assignment("beta = 0.3").unwrap();
         assert_eq!(p.get("beta"), Some(0.3));
         let e = p.set_assignment("kp=1").unwrap_err().to_string();
-        assert_eq!(e, "gda has no parameter `kp` (it has: beta)");
+        assert_eq!(e, "gda has no parameter `kp` (it has: beta, normalization)");
         let e = p.set_assignment("beta").unwrap_err().to_string();
         assert_eq!(e, "`beta`: expected NAME=VALUE");
         let e = p.set_assignment("beta=nan").unwrap_err().to_string();
         assert_eq!(e, "`beta` = NaN: must be finite and ≥ 0");
+        p.set_assignment("gda.beta=0.4").unwrap();
+        assert_eq!(p.get("beta"), Some(0.4));
+        p.set_assignment("normalization = xio").unwrap();
+        assert_eq!(p.settings().normalization, GdaNormalization::Xio);
+        let e = p
+            .set_assignment("gda.normalization=fast")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "`normalization`: `fast` is not gradient, residual or xio"
+        );
+        let e = p.set_assignment("ekf.beta=1").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "gda has no parameter `ekf.beta` (it has: beta, normalization)"
+        );
+        let mut k = FilterParams::defaults(FilterKind::Ekf);
+        k.set_assignment("initial_bias_std=0.01").unwrap();
+        assert_eq!(k.settings().initial_bias_std, 0.01);
+        let e = k
+            .set_assignment("initial_attitude_std=0")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "`initial_attitude_std`: `0` is not a finite number > 0");
     }
 }
