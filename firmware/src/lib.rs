@@ -8,6 +8,7 @@
 //! - [`link`]: the device side of the host link: frames in through the shared accumulator,
 //!   samples (register images, or kinematics through the shared model) swapped into the chip at
 //!   each sample instant, credits, telemetry and register writes out.
+//! - [`fault`]: the rig's fault schedule as the host sent it (`margemu_model::fault`).
 //! - [`chain_bench`]: the sampling-chain benchmark cases the host and the Cortex-M4F both run
 //!   (bit-identity and cost of `margemu_model::chain`).
 //! - [`spi_shadow`]: for boards whose SPI target cannot answer the address byte in time: the
@@ -18,6 +19,7 @@
 
 pub mod chain_bench;
 pub mod chip;
+pub mod fault;
 pub mod link;
 pub mod spi_shadow;
 

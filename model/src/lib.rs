@@ -4,6 +4,7 @@
 
 pub mod chain;
 pub mod error;
+pub mod fault;
 pub mod noise;
 pub mod perturbation;
 pub mod rng;

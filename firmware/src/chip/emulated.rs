@@ -90,6 +90,26 @@ pub trait Chip: SpiTarget + I2cTarget {
     fn spi_read_dummy(&self) -> Option<u8> {
         None
     }
+    /// Fault hook (`margemu_model::fault::FaultKind::Reset`): the chip resets itself to its
+    /// power-on register values, as after a power cycle (configuration, FIFO, interrupt state
+    /// and data registers as the datasheet gives them after power-up), keeping its clock.
+    /// Returns `false` where the chip does not implement it yet.
+    fn fault_reset(&mut self) -> bool {
+        false
+    }
+    /// Fault hook (`FaultKind::WrongIdentity`): the identity register (WHO_AM_I, CHIP_ID, …)
+    /// reads `value` until called again with `None`. Returns `false` where not implemented.
+    fn fault_identity(&mut self, value: Option<u8>) -> bool {
+        let _ = value;
+        false
+    }
+    /// Fault hook (`FaultKind::FifoOverflow`): the FIFO overflows now, as if nobody had read it
+    /// (the chip's overflow flag, interrupt and FIFO contents as the datasheet says), and keeps
+    /// overflowing while `on`. Returns `false` for a chip without a FIFO.
+    fn fault_fifo_overflow(&mut self, on: bool) -> bool {
+        let _ = on;
+        false
+    }
     /// The 7-bit I2C addresses the chip acknowledges now, at most two (a board's I2C peripheral
     /// owns two: the MPU-9250's own address, and the AK8963's in bypass mode). The default is
     /// [`Chip::i2c_address`] alone.
@@ -320,6 +340,15 @@ impl Chip for EmulatedChip {
     }
     fn i2c_addresses_now(&self) -> [Option<u8>; 2] {
         each_chip!(self, c => c.i2c_addresses_now())
+    }
+    fn fault_reset(&mut self) -> bool {
+        each_chip!(self, c => Chip::fault_reset(c))
+    }
+    fn fault_identity(&mut self, value: Option<u8>) -> bool {
+        each_chip!(self, c => Chip::fault_identity(c, value))
+    }
+    fn fault_fifo_overflow(&mut self, on: bool) -> bool {
+        each_chip!(self, c => Chip::fault_fifo_overflow(c, on))
     }
 }
 

@@ -296,6 +296,14 @@ impl ChipSettings {
             .filter(move |&(file, reg, value)| value != power_on_value(model, file, reg))
     }
 
+    /// Writes the chip's own invalid value into the data of the sensors in `sensors` (bits of
+    /// `margemu_model::fault::Sensor::bit`) of an image this chip's [`ChipSettings::image`]
+    /// made: the dropout fault. Sensors the chip does not have are left alone.
+    pub fn mark_invalid(&self, image: &mut Image, sensors: u8) {
+        // Filled in per chip family with the dropout fault (each chip module's invalid value).
+        let _ = (image, sensors);
+    }
+
     /// The register image of `sample` (chip axes) under these settings, of the model's length
     /// (the first bytes of the family's image; zero-padded should a model and a conversion of
     /// different families ever be paired).

@@ -68,6 +68,9 @@ pub struct Scene {
     pub sampling: vibration::SamplingPath,
     /// Legal but likely wrong inputs, located (commands print them once, to stderr).
     pub warnings: Vec<SceneWarning>,
+    /// The fault schedule (`[[fault]]`), validated, in file order; each fault's `device` is its
+    /// index in [`Scene::devices`]. Empty when the scene has none.
+    pub faults: Vec<margemu_model::fault::Fault>,
 }
 
 impl Scene {
@@ -104,6 +107,7 @@ impl Scene {
             vibration: Vec::new(),
             sampling: vibration::SamplingPath::Auto,
             warnings,
+            faults: Vec::new(),
         };
         scene.check_gains()?;
         scene.resolve_vibration()?;
