@@ -16,6 +16,7 @@
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `marg.csv`);
 //! - [`meta`]: the schema of `meta.toml`, written and read by the same types;
 //! - [`rundir`]: which directory a run writes to, and the completion record written last;
+//! - [`frame`]: named world frames (NWU, ENU, NED/FRD) and the one NED map;
 //! - [`quat`]: attitude quaternions as the logs and scores use them (normalisation, Euler
 //!   angles, geodesic distance, interpolation);
 //! - [`filter_params`]: which reference filter runs with which parameters, and their file
@@ -26,6 +27,7 @@ pub mod bench;
 pub mod csv_column;
 pub mod csv_table;
 pub mod filter_params;
+pub mod frame;
 pub mod guard;
 pub mod input_file;
 pub mod marg;

@@ -16,7 +16,7 @@
 //!
 //! North is world x in both cases.
 
-use margemu_sim::truth::{canonical_euler, wrap_angle};
+use margemu_sim::truth::canonical_euler;
 use nalgebra::{Quaternion, UnitQuaternion};
 
 /// Standard gravity, m/s² (MAVLink's milli-g).
@@ -64,25 +64,8 @@ impl Attitude {
 }
 
 /// A NED/FRD vector, quaternion or Euler triple in margemu's frames (and back: the map is an
-/// involution).
-pub mod from_ned {
-    use super::wrap_angle;
-
-    /// Body or world vector: `(x, y, z) → (x, −y, −z)`.
-    pub fn vector(v: [f64; 3]) -> [f64; 3] {
-        [v[0], -v[1], -v[2]]
-    }
-
-    /// Quaternion: `(w, x, y, z) → (w, x, −y, −z)`.
-    pub fn quaternion(q: [f64; 4]) -> [f64; 4] {
-        [q[0], q[1], -q[2], -q[3]]
-    }
-
-    /// ZYX Euler angles: `(roll, pitch, yaw) → (roll, −pitch, −yaw)`, yaw wrapped to (−π, π].
-    pub fn euler(e: [f64; 3]) -> [f64; 3] {
-        [e[0], -e[1], wrap_angle(-e[2])]
-    }
-}
+/// involution); the one map, [`margemu_sim::frame::ned`].
+pub use margemu_sim::frame::ned as from_ned;
 
 /// MSP (Betaflight/INAV) attitude in margemu's conventions.
 pub mod from_msp {
@@ -175,18 +158,5 @@ mod tests {
         assert!(nose[1] < -0.98, "heading east: {nose:?}");
         assert!(right_wing[2] < -0.3, "right wing down: {right_wing:?}");
         assert_relative_eq!(a.euler[2], -std::f64::consts::FRAC_PI_2, epsilon = 1e-15);
-    }
-
-    #[test]
-    fn the_ned_map_is_an_involution() {
-        let e = [0.1, -0.2, -3.0];
-        let twice = from_ned::euler(from_ned::euler(e));
-        for (x, y) in twice.iter().zip(e) {
-            assert_relative_eq!(*x, y, epsilon = 1e-15);
-        }
-        assert_eq!(
-            from_ned::quaternion(from_ned::quaternion([0.5, 0.1, 0.2, 0.3])),
-            [0.5, 0.1, 0.2, 0.3]
-        );
     }
 }
