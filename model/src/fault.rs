@@ -458,21 +458,18 @@ impl SensorFaults {
             }
             match fault.kind {
                 FaultKind::Scale { sensor, factor } => {
-                    let v = sensor.of(sample);
-                    for i in 0..3 {
-                        v[i] *= factor[i];
+                    for (x, k) in sensor.of(sample).iter_mut().zip(factor) {
+                        *x *= k;
                     }
                 }
                 FaultKind::BiasStep { sensor, bias } => {
-                    let v = sensor.of(sample);
-                    for i in 0..3 {
-                        v[i] += bias[i];
+                    for (x, b) in sensor.of(sample).iter_mut().zip(bias) {
+                        *x += b;
                     }
                 }
                 FaultKind::Noise { sensor, std } => {
-                    let v = sensor.of(sample);
-                    for i in 0..3 {
-                        v[i] += std[i] * standard_normal(rng);
+                    for (x, s) in sensor.of(sample).iter_mut().zip(std) {
+                        *x += s * standard_normal(rng);
                     }
                 }
                 FaultKind::Spikes {
@@ -495,8 +492,8 @@ impl SensorFaults {
                     }
                 }
                 FaultKind::MagSaturation { field } => {
-                    for i in 0..3 {
-                        sample.mag[i] += field[i];
+                    for (x, b) in sample.mag.iter_mut().zip(field) {
+                        *x += b;
                     }
                 }
                 FaultKind::Stuck { sensor } => stuck[sensor as usize] = true,
