@@ -19,6 +19,7 @@
 
 pub mod joint;
 pub mod pid;
+mod pid_table;
 
 use crate::reference::{Reference, ReferenceError};
 use crate::scene::{Method, Scene, JOINT_NAMES};

@@ -97,34 +97,46 @@ pub fn synthesize(
     }
 }
 
+/// ζ, normalized overshoot, normalized settling time.
+type Normalized = (f64, f64, f64);
+
 /// ζ with the normalized overshoot and settling time of its step response, for an overshoot
 /// requirement, pole ratio and retuning margin. It does not depend on mass, friction or the
-/// settling requirement, so it is computed once per process for each combination.
-fn normalized_design(overshoot: f64, pole_ratio: f64, margin: Option<f64>) -> (f64, f64, f64) {
+/// settling requirement: the default requirements' designs are stored ([`super::pid_table`]),
+/// any other is searched once per process for each combination.
+fn normalized_design(overshoot: f64, pole_ratio: f64, margin: Option<f64>) -> Normalized {
     use std::collections::HashMap;
     use std::sync::{Mutex, OnceLock};
     type Key = (u64, u64, Option<u64>);
-    /// ζ, normalized overshoot, normalized settling time.
-    type Normalized = (f64, f64, f64);
     static MEMO: OnceLock<Mutex<HashMap<Key, Normalized>>> = OnceLock::new();
     let key = (
         overshoot.to_bits(),
         pole_ratio.to_bits(),
         margin.map(f64::to_bits),
     );
+    if let Some(entry) = super::pid_table::TABLE.iter().find(|e| e.key == key) {
+        let (zeta, os, ts) = entry.design;
+        return (f64::from_bits(zeta), f64::from_bits(os), f64::from_bits(ts));
+    }
     let memo = MEMO.get_or_init(Default::default);
     if let Some(hit) = memo.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
         return *hit;
     }
+    let design = search_normalized_design(overshoot, pole_ratio, margin);
+    memo.lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(key, design);
+    design
+}
+
+/// [`normalized_design`] by the search itself: the bisection on ζ, then the step response.
+fn search_normalized_design(overshoot: f64, pole_ratio: f64, margin: Option<f64>) -> Normalized {
     let zeta0 = damping_for_overshoot(overshoot);
     let zeta = match margin {
         None => zeta0,
         Some(m) => smallest_damping(zeta0, pole_ratio, m * overshoot),
     };
     let (os, ts) = normalized_step(zeta, pole_ratio);
-    memo.lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .insert(key, (zeta, os, ts));
     (zeta, os, ts)
 }
 
@@ -233,6 +245,71 @@ mod tests {
                 assert!(os < last, "ratio {pole_ratio}, ζ {zeta}: {os} ≥ {last}");
                 last = os;
             }
+        }
+    }
+
+    #[test]
+    fn the_table_is_what_the_search_computes() {
+        // The scene file's defaults (`ControlSpec::default`), each overshoot with and without
+        // retuning, are the table's keys.
+        let spec = crate::scene::ControlSpec::default();
+        let mut keys: Vec<(f64, f64, Option<f64>)> = Vec::new();
+        for overshoot in spec.overshoot {
+            for margin in [Some(spec.retune_margin), None] {
+                if !keys.contains(&(overshoot, spec.pole_ratio, margin)) {
+                    keys.push((overshoot, spec.pole_ratio, margin));
+                }
+            }
+        }
+        let mut text = String::new();
+        for &(overshoot, pole_ratio, margin) in &keys {
+            let (zeta, os, ts) = search_normalized_design(overshoot, pole_ratio, margin);
+            let hex = |x: f64| format!("0x{:016x}", x.to_bits());
+            let margin_text = margin.map_or("None".to_owned(), |m| format!("Some({})", hex(m)));
+            text += &format!(
+                "    Entry {{\n        key: ({}, {}, {margin_text}),\n        design: ({}, {}, {}),\n    }},\n",
+                hex(overshoot),
+                hex(pole_ratio),
+                hex(zeta),
+                hex(os),
+                hex(ts),
+            );
+        }
+        let table: Vec<_> = super::super::pid_table::TABLE
+            .iter()
+            .map(|e| (e.key, e.design))
+            .collect();
+        let searched: Vec<_> = keys
+            .iter()
+            .map(|&(o, p, m)| {
+                let (z, os, ts) = search_normalized_design(o, p, m);
+                (
+                    (o.to_bits(), p.to_bits(), m.map(f64::to_bits)),
+                    (z.to_bits(), os.to_bits(), ts.to_bits()),
+                )
+            })
+            .collect();
+        assert_eq!(
+            table, searched,
+            "sim/src/bench/pid_table.rs is stale; its TABLE entries are now:\n{text}"
+        );
+    }
+
+    #[test]
+    fn the_table_and_the_search_give_the_same_gains() {
+        let req = Requirement {
+            overshoot: 0.4,
+            settling_time: 0.3,
+        };
+        let stored = synthesize(1.3, 0.02, req, 10.0, Some(0.9));
+        // A margin one ulp away is not in the table: the search runs, and lands ulps away.
+        let searched = synthesize(1.3, 0.02, req, 10.0, Some(0.9f64.next_up()));
+        for (a, b) in [
+            (stored.gains.kp, searched.gains.kp),
+            (stored.gains.ki, searched.gains.ki),
+            (stored.gains.kd, searched.gains.kd),
+        ] {
+            assert!(((a - b) / a).abs() < 1e-9, "{a} vs {b}");
         }
     }
 }
