@@ -92,24 +92,23 @@ pub trait Chip: SpiTarget + I2cTarget {
     }
     /// Fault hook (`margemu_model::fault::FaultKind::Reset`): the chip resets itself to its
     /// power-on register values, as after a power cycle (configuration, FIFO, interrupt state
-    /// and data registers as the datasheet gives them after power-up), keeping its clock.
-    /// Returns `false` where the chip does not implement it yet.
-    fn fault_reset(&mut self) -> bool {
-        false
-    }
-    /// Fault hook (`FaultKind::WrongIdentity`): the identity register (WHO_AM_I, CHIP_ID, …)
-    /// reads `value` until called again with `None`. Returns `false` where not implemented.
-    fn fault_identity(&mut self, value: Option<u8>) -> bool {
-        let _ = value;
-        false
-    }
-    /// Fault hook (`FaultKind::FifoOverflow`): the FIFO overflows now, as if nobody had read it
-    /// (the chip's overflow flag, interrupt and FIFO contents as the datasheet says), and keeps
-    /// overflowing while `on`. Returns `false` for a chip without a FIFO.
-    fn fault_fifo_overflow(&mut self, on: bool) -> bool {
-        let _ = on;
-        false
-    }
+    /// and data registers as the datasheet gives them after power-up), keeping its clock and
+    /// its write log, and goes on taking samples under the power-on settings. A fault window's
+    /// own overrides ([`Chip::fault_identity`], [`Chip::fault_fifo_overflow`]) survive it.
+    /// Returns whether the chip models the fault.
+    ///
+    /// No default: each chip decides (every emulated chip implements it).
+    fn fault_reset(&mut self) -> bool;
+    /// Fault hook (`FaultKind::WrongIdentity`): every identity register of the chip (WHO_AM_I,
+    /// CHIP_ID, the AK8963's WIA, …) reads `value` until called again with `None`. Returns
+    /// whether the chip models the fault. No default: each chip decides.
+    fn fault_identity(&mut self, value: Option<u8>) -> bool;
+    /// Fault hook (`FaultKind::FifoOverflow`): while `on`, the FIFO overflows as if nobody had
+    /// read it (the chip's overflow flag, interrupt, count and contents as its datasheet says),
+    /// from the chip's next sample on and at every sample after it; `false` turns it off (the
+    /// FIFO then fills normally; what overflowed stays until the driver resets the FIFO).
+    /// Returns `false` for a chip without a FIFO. No default: each chip decides.
+    fn fault_fifo_overflow(&mut self, on: bool) -> bool;
     /// The 7-bit I2C addresses the chip acknowledges now, at most two (a board's I2C peripheral
     /// owns two: the MPU-9250's own address, and the AK8963's in bypass mode). The default is
     /// [`Chip::i2c_address`] alone.
