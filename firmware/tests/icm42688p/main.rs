@@ -7,6 +7,7 @@
 
 #![allow(missing_docs)]
 
+mod afsr;
 mod bus;
 mod data;
 mod fc;
