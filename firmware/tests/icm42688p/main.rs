@@ -10,6 +10,7 @@
 mod afsr;
 mod bus;
 mod data;
+mod faults;
 mod fc;
 mod fc_ardupilot;
 mod fc_betaflight;
