@@ -390,4 +390,76 @@ mod tests {
             assert_eq!(chip.settings(), want, "{model:?} at its largest ranges");
         }
     }
+
+    /// The register holding the identity of `model` (of its first die).
+    fn identity_register(model: ChipModel) -> u8 {
+        match model {
+            ChipModel::Bmi270 | ChipModel::Bmi088 | ChipModel::Ist8310 => 0x00,
+            ChipModel::Qmc5883l => 0x0D,
+            ChipModel::Rm3100 => 0x36,
+            _ => 0x75,
+        }
+    }
+
+    fn i2c_read(chip: &mut EmulatedChip, address: u8, register: u8) -> Option<u8> {
+        let acked = chip.start(address, false) && I2cTarget::write(chip, register);
+        let value = (acked && chip.start(address, true)).then(|| I2cTarget::read(chip));
+        chip.stop();
+        value
+    }
+
+    /// Every emulated chip implements the reset and wrong-identity hooks, and the FIFO one
+    /// exactly when it has a FIFO; a reset brings back the power-on settings after a
+    /// configuration, and a wrong identity shows in every die's identity register until
+    /// restored.
+    #[test]
+    fn every_chip_implements_its_fault_hooks() {
+        for model in EmulatedChip::models() {
+            let address = model.i2c_addresses()[0];
+            let mut chip = EmulatedChip::new(model, model.who_am_i(), address).unwrap();
+            let dies = [Some(address), model.second_die_i2c_address(address)];
+            let reg = identity_register(model);
+            let ids = |chip: &mut EmulatedChip| dies.map(|d| d.map(|d| i2c_read(chip, d, reg)));
+            let before = ids(&mut chip);
+            assert_eq!(before[0], Some(Some(model.who_am_i())), "{model:?}");
+            assert!(
+                before.iter().flatten().all(Option::is_some),
+                "{model:?}: {before:?}"
+            );
+            assert!(chip.fault_identity(Some(0xA5)), "{model:?}");
+            let wrong = ids(&mut chip);
+            assert!(
+                wrong.iter().flatten().all(|v| *v == Some(0xA5)),
+                "{model:?}: {wrong:?}"
+            );
+            assert!(chip.fault_identity(None));
+            assert_eq!(ids(&mut chip), before, "{model:?}: restored");
+
+            let has_fifo = !matches!(
+                model,
+                ChipModel::Ist8310 | ChipModel::Qmc5883l | ChipModel::Rm3100
+            );
+            assert_eq!(chip.fault_fifo_overflow(true), has_fifo, "{model:?}");
+            assert_eq!(chip.fault_fifo_overflow(false), has_fifo, "{model:?}");
+
+            let power_on = ChipSettings::power_on(model);
+            let fs = margemu_protocol::chip::FullScale {
+                accel_g: ChipSettings::accel_ranges_g(model).last().unwrap_or(0.0),
+                gyro_dps: ChipSettings::gyro_ranges_dps(model).last().unwrap_or(0.0),
+            };
+            let configured = match ChipSettings::mag_ranges_gauss(model).last() {
+                Some(&gauss) => power_on.with_mag_range(gauss).unwrap(),
+                None if model.is_magnetometer_only() => power_on,
+                None => ChipSettings::with_full_scale(model, fs).unwrap(),
+            };
+            for (file, register, value) in configured.config_writes(1000.0) {
+                assert!(chip.write_register(file, register, value), "{model:?}");
+            }
+            assert_eq!(chip.settings(), configured, "{model:?}");
+            chip.advance(5_000_000);
+            assert!(chip.fault_reset(), "{model:?}");
+            assert_eq!(chip.settings(), power_on, "{model:?}: power-on settings");
+            assert_eq!(chip.now_ns(), 5_000_000, "{model:?}: the clock is kept");
+        }
+    }
 }
