@@ -117,14 +117,16 @@ impl Qmc5883l {
     /// the datasheet's soft reset (CONF2.SOFT_RST: "restore default value of all registers")
     /// also gives: standby, CONF1/CONF2/SET_RESET_PERIOD 0, DRDY/OVL/DOR clear, the data
     /// registers 0, the register pointer at 0. The clock, the held field, the write log and a
-    /// wrong-identity override are kept. A driver's read-back of CONF1 (ArduPilot's QMC5883L
-    /// driver checks it) sees standby instead of continuous mode, and no new data comes.
+    /// wrong-identity override are kept. A driver's read-back of CONF1 sees standby instead of
+    /// continuous mode (and of 0x20/0x21, which ArduPilot's driver sets, 0), and no new data
+    /// comes.
     pub fn fault_reset(&mut self) {
         self.reset();
         self.pointer = 0;
     }
 
-    /// The wrong-identity fault: CHIP_ID (0x0D) reads `value` until `None`.
+    /// The wrong-identity fault: CHIP_ID (0x0D) reads `value` until `None`. (0x0C, which
+    /// ArduPilot's probe also checks for 0x01, is a reserved register, not an identity: kept.)
     pub fn fault_identity(&mut self, value: Option<u8>) {
         self.identity = value;
     }

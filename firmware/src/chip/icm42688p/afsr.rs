@@ -71,7 +71,7 @@ impl Icm42688p {
         let lsb = GyroFs::from_gyro_config0(self.reg0(bank0::GYRO_CONFIG0)).lsb_per_dps();
         let threshold = (AFSR_THRESHOLD_DPS * lsb) as i32;
         let previous = self.latest_data();
-        for axis in 0..3 {
+        for (axis, out20) in gyro20.iter_mut().enumerate() {
             let at = field::GYRO.start + 2 * axis;
             let (Some(new), Some(old)) = (data.get_mut(at..at + 2), previous.get(at..at + 2))
             else {
@@ -80,18 +80,25 @@ impl Icm42688p {
             let raw = i32::from(i16::from_be_bytes([new[0], new[1]]));
             let high = raw.abs() >= threshold;
             let state = &mut self.afsr;
-            let stalled = state.stall_until[axis].is_some_and(|end| now < end);
+            let (Some(was_high), Some(stall), Some(last20)) = (
+                state.high.get_mut(axis),
+                state.stall_until.get_mut(axis),
+                state.last20.get_mut(axis),
+            ) else {
+                continue;
+            };
+            let stalled = stall.is_some_and(|end| now < end);
             if !enabled {
-                state.stall_until[axis] = None;
-            } else if high != state.high[axis] && !stalled {
-                state.stall_until[axis] = Some(now.saturating_add(AFSR_STALL_NS));
+                *stall = None;
+            } else if high != *was_high && !stalled {
+                *stall = Some(now.saturating_add(AFSR_STALL_NS));
             }
-            state.high[axis] = high;
-            if enabled && state.stall_until[axis].is_some_and(|end| now < end) {
+            *was_high = high;
+            if enabled && stall.is_some_and(|end| now < end) {
                 new.copy_from_slice(old);
-                gyro20[axis] = state.last20[axis];
+                *out20 = *last20;
             }
-            state.last20[axis] = gyro20[axis];
+            *last20 = *out20;
         }
     }
 }
