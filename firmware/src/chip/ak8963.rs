@@ -496,4 +496,29 @@ mod tests {
         ak.start(0x0C, true);
         assert_eq!([ak.read(), ak.read()], [0x40, 0x48], "0x0C wraps to WIA");
     }
+
+    #[test]
+    fn fault_reset_and_wrong_identity() {
+        let mut ak = ak();
+        ak.write_register(0x0A, 0x16); // continuous mode 2, 16-bit
+        ak.advance(20 * MS, MagSource::Physical([0.0, 15.0, 0.0]));
+        assert_eq!(read(&mut ak, 0x02, 1)[0] & 0x01, 0x01, "DRDY");
+        ak.fault_identity(Some(0x00));
+        ak.fault_reset();
+        assert_eq!(
+            read(&mut ak, 0x00, 3)[..3],
+            [0x00, 0x9A, 0x00],
+            "WIA wrong, ST1 clear"
+        );
+        assert_eq!(read(&mut ak, 0x03, 7)[..7], [0; 7], "data as at power-up");
+        assert_eq!(ak.mode(), Mode::PowerDown);
+        ak.advance(200 * MS, MagSource::Physical([0.0, 15.0, 0.0]));
+        assert_eq!(
+            read(&mut ak, 0x02, 1)[0],
+            0x00,
+            "no measurement until CNTL1 again"
+        );
+        ak.fault_identity(None);
+        assert_eq!(read(&mut ak, 0x00, 1)[0], 0x48);
+    }
 }
