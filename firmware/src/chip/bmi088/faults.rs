@@ -41,7 +41,7 @@ impl Bmi088Accel {
         self.fault.chip_id = value;
     }
 
-    /// The FIFO-overflow fault, on or off (see the [module docs](self)).
+    /// The FIFO-overflow fault, on or off (see `faults.rs`).
     pub fn fault_fifo_overflow(&mut self, on: bool) {
         self.fault.fifo_overflow = on;
     }
@@ -53,14 +53,14 @@ impl Bmi088Gyro {
         self.fault.chip_id = value;
     }
 
-    /// The FIFO-overflow fault, on or off (see the [module docs](self)).
+    /// The FIFO-overflow fault, on or off (see `faults.rs`).
     pub fn fault_fifo_overflow(&mut self, on: bool) {
         self.fault.fifo_overflow = on;
     }
 }
 
 impl Bmi088 {
-    /// The reset fault: both dies power-cycled (see the [module docs](self)).
+    /// The reset fault: both dies power-cycled (see `faults.rs`).
     pub fn fault_reset(&mut self) {
         self.accel.power_cycle();
         self.gyro.power_cycle();

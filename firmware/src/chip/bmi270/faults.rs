@@ -32,7 +32,7 @@ pub(super) struct FaultState {
 }
 
 impl Bmi270 {
-    /// The reset fault: a power cycle (see the [module docs](self)).
+    /// The reset fault: a power cycle (see `faults.rs`).
     pub fn fault_reset(&mut self) {
         self.power_cycle();
     }
@@ -42,7 +42,7 @@ impl Bmi270 {
         self.fault.chip_id = value;
     }
 
-    /// The FIFO-overflow fault, on or off (see the [module docs](self)).
+    /// The FIFO-overflow fault, on or off (see `faults.rs`).
     pub fn fault_fifo_overflow(&mut self, on: bool) {
         self.fault.fifo_overflow = on;
     }

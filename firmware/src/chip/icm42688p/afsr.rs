@@ -29,12 +29,12 @@
 //! (the state follows the rate, so turning AFSR on later starts from the current range).
 
 use margemu_protocol::regmap::icm42688p::image::field;
-use margemu_protocol::regmap::icm42688p::{bank0, GyroFs, DATA_LEN};
+use margemu_protocol::regmap::icm42688p::{bank0, bits, GyroFs, DATA_LEN};
 
 use super::Icm42688p;
 
 /// The angular rate at which the gyro's range switches, °/s (ArduPilot PR #25332; see the
-/// [module docs](self)).
+/// module docs of `afsr.rs`, and the chip docs of [`Icm42688p`]).
 pub const AFSR_THRESHOLD_DPS: f32 = 100.0;
 
 /// How long an axis's output holds at a switch, ns: 2 ms, the upper end of the 1–2 ms the
@@ -42,8 +42,7 @@ pub const AFSR_THRESHOLD_DPS: f32 = 100.0;
 /// of 1 kHz and above.
 pub const AFSR_STALL_NS: u64 = 2_000_000;
 
-/// INTF_CONFIG1's AFSR field and the code that turns AFSR off.
-const AFSR_MASK: u8 = 0xC0;
+/// The code of INTF_CONFIG1's AFSR field (`bits::AFSR`, bits 7:6) that turns AFSR off.
 const AFSR_OFF: u8 = 0x40;
 
 /// The gyro's range state per axis and its stalls.
@@ -60,7 +59,7 @@ pub(super) struct Afsr {
 impl Icm42688p {
     /// Whether AFSR is on (INTF_CONFIG1 bits 7:6 other than 01).
     pub fn afsr_enabled(&self) -> bool {
-        self.reg0(bank0::INTF_CONFIG1) & AFSR_MASK != AFSR_OFF
+        self.reg0(bank0::INTF_CONFIG1) & bits::AFSR != AFSR_OFF
     }
 
     /// Applies AFSR to a new gyro sample at the chip's clock: `data` (the big-endian data

@@ -36,7 +36,7 @@ pub(super) struct FaultState {
 }
 
 impl Icm42688p {
-    /// The reset fault: a power cycle (see the [module docs](self)).
+    /// The reset fault: a power cycle (see `faults.rs`).
     pub fn fault_reset(&mut self) {
         self.power_cycle();
     }
@@ -46,7 +46,7 @@ impl Icm42688p {
         self.fault.who_am_i = value;
     }
 
-    /// The FIFO-overflow fault, on or off (see the [module docs](self)).
+    /// The FIFO-overflow fault, on or off (see `faults.rs`).
     pub fn fault_fifo_overflow(&mut self, on: bool) {
         self.fault.fifo_overflow = on;
     }

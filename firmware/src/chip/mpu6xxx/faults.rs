@@ -41,7 +41,7 @@ pub(super) struct FaultState {
 }
 
 impl Mpu6xxx {
-    /// The reset fault: a power cycle of both dies (see the [module docs](self)).
+    /// The reset fault: a power cycle of both dies (see `faults.rs`).
     pub fn fault_reset(&mut self) {
         self.power_cycle();
     }
@@ -54,7 +54,7 @@ impl Mpu6xxx {
         }
     }
 
-    /// The FIFO-overflow fault, on or off (see the [module docs](self)).
+    /// The FIFO-overflow fault, on or off (see `faults.rs`).
     pub fn fault_fifo_overflow(&mut self, on: bool) {
         self.fault.fifo_overflow = on;
     }
