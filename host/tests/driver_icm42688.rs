@@ -32,6 +32,14 @@
 //!   are checked for packets 1–3. The SI conversions use g = 9.81 (350 ppm above the standard
 //!   gravity the chip's sensitivity is in).
 //!
+//! - AFSR: the crate never writes INTF_CONFIG1, so AFSR stays on as at power-on and its users
+//!   get the gyro stall every flight firmware turns off (2 ms held at each crossing of
+//!   ±100 °/s, `margemu_firmware::chip::icm42688p`'s `afsr` module): a finding about the
+//!   crate, shown by `the_crate_leaves_afsr_on_and_its_gyro_stalls`. The conversion checks
+//!   below turn AFSR off from the rig side first ([`afsr_off`], the one register write a user
+//!   of the crate would have to add, through no API of the crate), so they check the
+//!   conversions and not the stall.
+//!
 //! For every accel × gyro full scale, samples are latched between driver calls: zero, ±1 LSB,
 //! ±full scale and beyond it (saturation), negative values, −40 … 85 °C; every value the crate
 //! returns must be within one LSB of the latched sample (clipped as the register clips).
@@ -46,7 +54,7 @@ use icm42688::{
 };
 use margemu::bus::{self, Clock, Shared};
 use margemu_firmware::chip::icm42688p::Config;
-use margemu_firmware::chip::{Icm42688p as Chip, PhysicalSample};
+use margemu_firmware::chip::{Chip as _, Icm42688p as Chip, PhysicalSample};
 use margemu_protocol::regmap::icm42688p::convert::{
     accel_to_raw, accel_to_raw20, fifo_temp8, gyro_to_raw, gyro_to_raw20, temp_to_raw,
 };
@@ -149,6 +157,16 @@ fn samples(
     out
 }
 
+/// Turns AFSR off from the rig side (INTF_CONFIG1 bits 7:6 = 01, the other bits kept, as
+/// Betaflight, ArduPilot and PX4 write it): the crate never does.
+fn afsr_off(chip: &Shared<Chip>) {
+    let value = chip.borrow().peek(0, 0x4D);
+    assert!(chip
+        .borrow_mut()
+        .write_register(0, 0x4D, (value & 0x3F) | 0x40));
+    assert!(!chip.borrow().afsr_enabled());
+}
+
 /// Worst deviations (accel, gyro, temperature) in LSB of the current full scale.
 #[derive(Clone, Copy, Debug, Default)]
 struct Worst {
@@ -232,6 +250,8 @@ fn replay(
 fn every_full_scale(ad0: bool) {
     let (chip, address) = chip(ad0);
     let mut icm = Icm::new(connect(&chip), address).unwrap();
+    assert!(chip.borrow().afsr_enabled(), "the crate leaves AFSR on");
+    afsr_off(&chip);
     assert_eq!(icm.device_id().unwrap(), 0x47);
     assert_eq!(
         chip.borrow().peek(0, 0x4E),
@@ -369,6 +389,7 @@ fn fifo_packets_over_i2c() {
             chip: chip.clone(),
         };
         let mut icm = Icm::new_fifo(connect(&chip), address, kind, &mut delay).unwrap();
+        afsr_off(&chip);
         let peek = |addr| chip.borrow().peek(0, addr);
         assert_eq!(peek(0x16), 0x80, "FIFO_CONFIG: stop on full");
         assert_eq!(peek(0x5F), config1, "FIFO_CONFIG1");
@@ -468,5 +489,42 @@ fn fifo_packets_over_i2c() {
             "stale low byte"
         );
         assert_eq!(icm.read_fifo_cnt().unwrap(), 0, "FIFO empty");
+    }
+}
+
+/// The crate leaves AFSR on (it never writes INTF_CONFIG1): through its own `gyro_raw`, a rate
+/// stepping from 90 to 110 °/s at ±2000 °/s reads the 90 °/s value for the 2 ms after the
+/// switch, then the live one; with AFSR off (a rig-side write) the step shows at once.
+#[test]
+fn the_crate_leaves_afsr_on_and_its_gyro_stalls() {
+    for afsr in [true, false] {
+        let (chip, address) = chip(false);
+        let mut icm = Icm::new(connect(&chip), address).unwrap();
+        assert_eq!(
+            chip.borrow().peek(0, 0x4D),
+            0x91,
+            "INTF_CONFIG1 at its reset value"
+        );
+        if !afsr {
+            afsr_off(&chip);
+        }
+        let at_dps = |dps: f64| PhysicalSample {
+            gyr: [(dps / DEG_PER_RAD) as f32, 0.0, 0.0],
+            ..PhysicalSample::default()
+        };
+        let (slow, fast) = (gyro_to_raw(at_dps(90.0).gyr[0], GyroFs::Dps2000), 1804);
+        assert_eq!(gyro_to_raw(at_dps(110.0).gyr[0], GyroFs::Dps2000), fast);
+        let mut xs = Vec::new();
+        for (k, dps) in [90.0, 110.0, 110.0, 110.0, 110.0].into_iter().enumerate() {
+            chip.borrow_mut()
+                .latch_at(&at_dps(dps), (k as u64 + 1) * PERIOD_NS);
+            xs.push(icm.gyro_raw().unwrap().x);
+        }
+        let want = if afsr {
+            [slow, slow, slow, fast, fast]
+        } else {
+            [slow, fast, fast, fast, fast]
+        };
+        assert_eq!(xs, want, "AFSR {}", if afsr { "on" } else { "off" });
     }
 }

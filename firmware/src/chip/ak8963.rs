@@ -76,6 +76,8 @@ pub struct Ak8963 {
     source: MagSource,
     pointer: u8,
     expect_register: bool,
+    /// What WIA reads under the wrong-identity fault (kept across resets).
+    identity: Option<u8>,
 }
 
 impl Ak8963 {
@@ -99,6 +101,7 @@ impl Ak8963 {
             source: MagSource::Physical([0.0; 3]),
             pointer: 0,
             expect_register: false,
+            identity: None,
         }
     }
 
@@ -108,8 +111,22 @@ impl Ak8963 {
         *self = Self {
             now_ns: self.now_ns,
             source: self.source,
+            identity: self.identity,
             ..Self::new(self.asa, self.info)
         };
+    }
+
+    /// The reset fault (`margemu_model::fault::FaultKind::Reset`): the die's power-on state,
+    /// which is its soft reset's (DS 8.3.6: SRST initialises every register; the fuse ROM is
+    /// read only): power-down mode, DRDY/DOR clear, the data registers 0. The clock, the held
+    /// field and a wrong-identity override are kept; the register pointer returns to 0.
+    pub fn fault_reset(&mut self) {
+        self.reset();
+    }
+
+    /// The wrong-identity fault: WIA reads `value` until `None`.
+    pub fn fault_identity(&mut self, value: Option<u8>) {
+        self.identity = value;
     }
 
     /// The fuse ROM sensitivity adjustment values.
@@ -135,7 +152,7 @@ impl Ak8963 {
     /// The register value at `addr`, without side effects.
     pub fn peek(&self, addr: u8) -> u8 {
         match addr {
-            reg::WIA => map::WIA_VALUE,
+            reg::WIA => self.identity.unwrap_or(map::WIA_VALUE),
             reg::INFO => self.info,
             reg::ST1 => flag(self.drdy, bits::ST1_DRDY) | flag(self.dor, bits::ST1_DOR),
             reg::HXL..=reg::HZH => self.data[usize::from(addr - reg::HXL)],
@@ -478,5 +495,30 @@ mod tests {
         ak.write(0x0C);
         ak.start(0x0C, true);
         assert_eq!([ak.read(), ak.read()], [0x40, 0x48], "0x0C wraps to WIA");
+    }
+
+    #[test]
+    fn fault_reset_and_wrong_identity() {
+        let mut ak = ak();
+        ak.write_register(0x0A, 0x16); // continuous mode 2, 16-bit
+        ak.advance(20 * MS, MagSource::Physical([0.0, 15.0, 0.0]));
+        assert_eq!(read(&mut ak, 0x02, 1)[0] & 0x01, 0x01, "DRDY");
+        ak.fault_identity(Some(0x00));
+        ak.fault_reset();
+        assert_eq!(
+            read(&mut ak, 0x00, 3)[..3],
+            [0x00, 0x9A, 0x00],
+            "WIA wrong, ST1 clear"
+        );
+        assert_eq!(read(&mut ak, 0x03, 7)[..7], [0; 7], "data as at power-up");
+        assert_eq!(ak.mode(), Mode::PowerDown);
+        ak.advance(200 * MS, MagSource::Physical([0.0, 15.0, 0.0]));
+        assert_eq!(
+            read(&mut ak, 0x02, 1)[0],
+            0x00,
+            "no measurement until CNTL1 again"
+        );
+        ak.fault_identity(None);
+        assert_eq!(read(&mut ak, 0x00, 1)[0], 0x48);
     }
 }

@@ -92,24 +92,23 @@ pub trait Chip: SpiTarget + I2cTarget {
     }
     /// Fault hook (`margemu_model::fault::FaultKind::Reset`): the chip resets itself to its
     /// power-on register values, as after a power cycle (configuration, FIFO, interrupt state
-    /// and data registers as the datasheet gives them after power-up), keeping its clock.
-    /// Returns `false` where the chip does not implement it yet.
-    fn fault_reset(&mut self) -> bool {
-        false
-    }
-    /// Fault hook (`FaultKind::WrongIdentity`): the identity register (WHO_AM_I, CHIP_ID, …)
-    /// reads `value` until called again with `None`. Returns `false` where not implemented.
-    fn fault_identity(&mut self, value: Option<u8>) -> bool {
-        let _ = value;
-        false
-    }
-    /// Fault hook (`FaultKind::FifoOverflow`): the FIFO overflows now, as if nobody had read it
-    /// (the chip's overflow flag, interrupt and FIFO contents as the datasheet says), and keeps
-    /// overflowing while `on`. Returns `false` for a chip without a FIFO.
-    fn fault_fifo_overflow(&mut self, on: bool) -> bool {
-        let _ = on;
-        false
-    }
+    /// and data registers as the datasheet gives them after power-up), keeping its clock and
+    /// its write log, and goes on taking samples under the power-on settings. A fault window's
+    /// own overrides ([`Chip::fault_identity`], [`Chip::fault_fifo_overflow`]) survive it.
+    /// Returns whether the chip models the fault.
+    ///
+    /// No default: each chip decides (every emulated chip implements it).
+    fn fault_reset(&mut self) -> bool;
+    /// Fault hook (`FaultKind::WrongIdentity`): every identity register of the chip (WHO_AM_I,
+    /// CHIP_ID, the AK8963's WIA, …) reads `value` until called again with `None`. Returns
+    /// whether the chip models the fault. No default: each chip decides.
+    fn fault_identity(&mut self, value: Option<u8>) -> bool;
+    /// Fault hook (`FaultKind::FifoOverflow`): while `on`, the FIFO overflows as if nobody had
+    /// read it (the chip's overflow flag, interrupt, count and contents as its datasheet says),
+    /// from the chip's next sample on and at every sample after it; `false` turns it off (the
+    /// FIFO then fills normally; what overflowed stays until the driver resets the FIFO).
+    /// Returns `false` for a chip without a FIFO. No default: each chip decides.
+    fn fault_fifo_overflow(&mut self, on: bool) -> bool;
     /// The 7-bit I2C addresses the chip acknowledges now, at most two (a board's I2C peripheral
     /// owns two: the MPU-9250's own address, and the AK8963's in bypass mode). The default is
     /// [`Chip::i2c_address`] alone.
@@ -389,6 +388,78 @@ mod tests {
                 assert!(chip.write_register(file, register, value), "{model:?}");
             }
             assert_eq!(chip.settings(), want, "{model:?} at its largest ranges");
+        }
+    }
+
+    /// The register holding the identity of `model` (of its first die).
+    fn identity_register(model: ChipModel) -> u8 {
+        match model {
+            ChipModel::Bmi270 | ChipModel::Bmi088 | ChipModel::Ist8310 => 0x00,
+            ChipModel::Qmc5883l => 0x0D,
+            ChipModel::Rm3100 => 0x36,
+            _ => 0x75,
+        }
+    }
+
+    fn i2c_read(chip: &mut EmulatedChip, address: u8, register: u8) -> Option<u8> {
+        let acked = chip.start(address, false) && I2cTarget::write(chip, register);
+        let value = (acked && chip.start(address, true)).then(|| I2cTarget::read(chip));
+        chip.stop();
+        value
+    }
+
+    /// Every emulated chip implements the reset and wrong-identity hooks, and the FIFO one
+    /// exactly when it has a FIFO; a reset brings back the power-on settings after a
+    /// configuration, and a wrong identity shows in every die's identity register until
+    /// restored.
+    #[test]
+    fn every_chip_implements_its_fault_hooks() {
+        for model in EmulatedChip::models() {
+            let address = model.i2c_addresses()[0];
+            let mut chip = EmulatedChip::new(model, model.who_am_i(), address).unwrap();
+            let dies = [Some(address), model.second_die_i2c_address(address)];
+            let reg = identity_register(model);
+            let ids = |chip: &mut EmulatedChip| dies.map(|d| d.map(|d| i2c_read(chip, d, reg)));
+            let before = ids(&mut chip);
+            assert_eq!(before[0], Some(Some(model.who_am_i())), "{model:?}");
+            assert!(
+                before.iter().flatten().all(Option::is_some),
+                "{model:?}: {before:?}"
+            );
+            assert!(chip.fault_identity(Some(0xA5)), "{model:?}");
+            let wrong = ids(&mut chip);
+            assert!(
+                wrong.iter().flatten().all(|v| *v == Some(0xA5)),
+                "{model:?}: {wrong:?}"
+            );
+            assert!(chip.fault_identity(None));
+            assert_eq!(ids(&mut chip), before, "{model:?}: restored");
+
+            let has_fifo = !matches!(
+                model,
+                ChipModel::Ist8310 | ChipModel::Qmc5883l | ChipModel::Rm3100
+            );
+            assert_eq!(chip.fault_fifo_overflow(true), has_fifo, "{model:?}");
+            assert_eq!(chip.fault_fifo_overflow(false), has_fifo, "{model:?}");
+
+            let power_on = ChipSettings::power_on(model);
+            let fs = margemu_protocol::chip::FullScale {
+                accel_g: ChipSettings::accel_ranges_g(model).last().unwrap_or(0.0),
+                gyro_dps: ChipSettings::gyro_ranges_dps(model).last().unwrap_or(0.0),
+            };
+            let configured = match ChipSettings::mag_ranges_gauss(model).last() {
+                Some(&gauss) => power_on.with_mag_range(gauss).unwrap(),
+                None if model.is_magnetometer_only() => power_on,
+                None => ChipSettings::with_full_scale(model, fs).unwrap(),
+            };
+            for (file, register, value) in configured.config_writes(1000.0) {
+                assert!(chip.write_register(file, register, value), "{model:?}");
+            }
+            assert_eq!(chip.settings(), configured, "{model:?}");
+            chip.advance(5_000_000);
+            assert!(chip.fault_reset(), "{model:?}");
+            assert_eq!(chip.settings(), power_on, "{model:?}: power-on settings");
+            assert_eq!(chip.now_ns(), 5_000_000, "{model:?}: the clock is kept");
         }
     }
 }

@@ -60,6 +60,8 @@ pub struct Ist8310 {
     address: u8,
     pub(super) bus: PointerI2c,
     pub(super) log: WriteLog<MAG_WRITE_LOG_LEN>,
+    /// What WAI reads under the wrong-identity fault (kept across resets).
+    identity: Option<u8>,
 }
 
 impl Default for Ist8310 {
@@ -89,6 +91,7 @@ impl Ist8310 {
             address: map::I2C_ADDRESS,
             bus: PointerI2c::new(),
             log: WriteLog::new(),
+            identity: None,
         }
     }
 
@@ -109,8 +112,26 @@ impl Ist8310 {
             address: self.address,
             bus: self.bus,
             log: self.log.clone(),
+            identity: self.identity,
             ..Self::new()
         };
+    }
+
+    /// The reset fault (`margemu_model::fault::FaultKind::Reset`): the power-on state, which
+    /// the datasheet's soft reset (CNTL2.SRST, "the power-on routine") also gives: stand-by,
+    /// every register at its reset value (AVGCNTL 0x24, PDCNTL 0xC0), DRDY/DOR clear, the data
+    /// registers 0, the register pointer at 0. The clock, the held field, the write log and a
+    /// wrong-identity override are kept. A driver in single-measurement mode (ArduPilot's and
+    /// PX4's IST8310 drivers re-trigger CNTL1 each period) simply starts the next measurement;
+    /// its read-back of AVGCNTL and PDCNTL sees the difference.
+    pub fn fault_reset(&mut self) {
+        self.reset();
+        self.pointer = 0;
+    }
+
+    /// The wrong-identity fault: WAI reads `value` until `None`.
+    pub fn fault_identity(&mut self, value: Option<u8>) {
+        self.identity = value;
     }
 
     /// The current operating mode.
@@ -136,7 +157,7 @@ impl Ist8310 {
     /// The register value at `addr`, without side effects.
     pub fn peek(&self, addr: u8) -> u8 {
         match addr {
-            reg::WAI => map::WAI_VALUE,
+            reg::WAI => self.identity.unwrap_or(map::WAI_VALUE),
             reg::STAT1 => flag(self.drdy, bits::STAT1_DRDY) | flag(self.dor, bits::STAT1_DOR),
             reg::DATAXL..=reg::DATAZH => self
                 .data

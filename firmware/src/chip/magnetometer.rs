@@ -10,6 +10,9 @@
 //!   the scene declares.
 //! - **Buses.** I2C only: the SPI side never drives MISO (reads 0x00) and ignores every byte.
 //! - **Interrupts.** The DRDY pin is not emulated: the level reads low and never pulses.
+//! - **Faults.** A reset fault is the chip's power-on state (each chip's `fault_reset`), a
+//!   wrong identity replaces WAI / CHIP_ID; neither chip has a FIFO, so the FIFO-overflow fault
+//!   does not apply (the hook returns `false`).
 //! - **Writes.** Every data byte a controller writes over I2C lands in the write log; register
 //!   overrides ([`Chip::write_register`], file 0) go through the same I2C target.
 //!
@@ -205,6 +208,18 @@ macro_rules! magnetometer_chip {
             }
             fn spi_read_burst(&self, _start: u8, out: &mut [u8]) {
                 out.fill(0x00);
+            }
+            fn fault_reset(&mut self) -> bool {
+                <$chip>::fault_reset(self);
+                true
+            }
+            fn fault_identity(&mut self, value: Option<u8>) -> bool {
+                <$chip>::fault_identity(self, value);
+                true
+            }
+            /// Neither chip has a FIFO: nothing can overflow.
+            fn fault_fifo_overflow(&mut self, _on: bool) -> bool {
+                false
             }
         }
     };

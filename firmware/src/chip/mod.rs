@@ -38,6 +38,12 @@
 //! - [`Rm3100`]: the PNI RM3100 magnetometer, on I2C and SPI.
 //!
 //! Register writes the device under test makes are kept in a [`WriteLog`] for telemetry.
+//!
+//! **Faults.** Every chip implements the [`Chip`] fault hooks (`fault_reset`,
+//! `fault_identity`, `fault_fifo_overflow`; no defaults), with the datasheet behaviour and the
+//! drivers that check it (a `faults` module in each IMU family, the magnetometers' own
+//! `fault_reset`; they have no FIFO to overflow); the ICM-42688-P also
+//! models its AFSR stall while a driver leaves AFSR on (`icm42688p::afsr`).
 
 mod ak8963;
 pub mod bmi088;

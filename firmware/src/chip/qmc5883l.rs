@@ -58,6 +58,8 @@ pub struct Qmc5883l {
     address: u8,
     pub(super) bus: PointerI2c,
     pub(super) log: WriteLog<MAG_WRITE_LOG_LEN>,
+    /// What CHIP_ID reads under the wrong-identity fault (kept across resets).
+    identity: Option<u8>,
 }
 
 impl Default for Qmc5883l {
@@ -85,6 +87,7 @@ impl Qmc5883l {
             address: map::I2C_ADDRESS,
             bus: PointerI2c::new(),
             log: WriteLog::new(),
+            identity: None,
         }
     }
 
@@ -105,8 +108,27 @@ impl Qmc5883l {
             address: self.address,
             bus: self.bus,
             log: self.log.clone(),
+            identity: self.identity,
             ..Self::new()
         };
+    }
+
+    /// The reset fault (`margemu_model::fault::FaultKind::Reset`): the power-on state, which
+    /// the datasheet's soft reset (CONF2.SOFT_RST: "restore default value of all registers")
+    /// also gives: standby, CONF1/CONF2/SET_RESET_PERIOD 0, DRDY/OVL/DOR clear, the data
+    /// registers 0, the register pointer at 0. The clock, the held field, the write log and a
+    /// wrong-identity override are kept. A driver's read-back of CONF1 sees standby instead of
+    /// continuous mode (and of 0x20/0x21, which ArduPilot's driver sets, 0), and no new data
+    /// comes.
+    pub fn fault_reset(&mut self) {
+        self.reset();
+        self.pointer = 0;
+    }
+
+    /// The wrong-identity fault: CHIP_ID (0x0D) reads `value` until `None`. (0x0C, which
+    /// ArduPilot's probe also checks for 0x01, is a reserved register, not an identity: kept.)
+    pub fn fault_identity(&mut self, value: Option<u8>) {
+        self.identity = value;
     }
 
     /// The current operating mode.
@@ -152,7 +174,7 @@ impl Qmc5883l {
             reg::CONF2 => self.conf2,
             reg::PERIOD => self.period,
             reg::RESERVED_0C => map::REG_0C_VALUE,
-            reg::CHIP_ID => map::CHIP_ID_VALUE,
+            reg::CHIP_ID => self.identity.unwrap_or(map::CHIP_ID_VALUE),
             reg::UNDOC_20 => self.undoc[0],
             reg::UNDOC_21 => self.undoc[1],
             _ => 0x00, // TOUT and unmapped addresses

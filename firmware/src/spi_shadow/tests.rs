@@ -615,6 +615,16 @@ impl Chip for Banked {
     fn i2c_address(&self) -> u8 {
         0x68
     }
+    // A test double of the shadow's view of a banked chip: it models no faults.
+    fn fault_reset(&mut self) -> bool {
+        false
+    }
+    fn fault_identity(&mut self, _value: Option<u8>) -> bool {
+        false
+    }
+    fn fault_fifo_overflow(&mut self, _on: bool) -> bool {
+        false
+    }
     fn spi_peek(&self, addr: u8) -> u8 {
         let addr = addr & 0x7F;
         match addr {

@@ -3,7 +3,7 @@
 use super::*;
 
 /// ±24 g, 1.6 kHz, FIFO mode with accel frames; `stop` chooses FIFO (stop-at-full) mode.
-fn fifo_accel(stop: bool) -> Bmi088Accel {
+pub fn fifo_accel(stop: bool) -> Bmi088Accel {
     let mut c = running_accel();
     spi_write(&mut c, 0x40, &[0xAC]);
     spi_write(&mut c, 0x41, &[0x03]);
@@ -13,12 +13,12 @@ fn fifo_accel(stop: bool) -> Bmi088Accel {
 }
 
 /// Accel X of numbered frame `k`: k/8 g at ±24 g.
-fn accel_k(c: &mut Bmi088Accel, k: u32) {
+pub fn accel_k(c: &mut Bmi088Accel, k: u32) {
     let s = sample([k as f32 / 8.0, -1.0, 0.5], [0.0; 3], 23.0);
     c.latch_at(&s, c.now_ns() + 625_000);
 }
 
-fn fifo_length(c: &mut Bmi088Accel) -> usize {
+pub fn fifo_length(c: &mut Bmi088Accel) -> usize {
     let len = aread(c, 0x24, 2);
     usize::from(u16::from_le_bytes([len[0], len[1]]))
 }
@@ -99,14 +99,14 @@ fn accel_downsampling_and_no_frames_unless_enabled() {
 }
 
 /// ±2000 °/s at 2 kHz, FIFO_CONFIG_1 = `mode`.
-fn fifo_gyro(mode: u8) -> Bmi088Gyro {
+pub fn fifo_gyro(mode: u8) -> Bmi088Gyro {
     let mut g = Bmi088Gyro::new();
     spi_write(&mut g, 0x3E, &[mode]);
     g
 }
 
 /// Gyro Z of numbered frame `k`: k °/s.
-fn gyro_k(g: &mut Bmi088Gyro, k: u32) {
+pub fn gyro_k(g: &mut Bmi088Gyro, k: u32) {
     let s = sample([0.0; 3], [-10.0, 20.0, k as f32], 23.0);
     g.latch_at(&s, g.now_ns() + 500_000);
 }

@@ -11,6 +11,7 @@
 mod boundary;
 mod bus;
 mod data;
+mod faults;
 mod fifo;
 mod px4;
 

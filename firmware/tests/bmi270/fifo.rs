@@ -7,7 +7,7 @@ const G: f32 = 9.80665;
 
 /// Configuration uploaded, accel and gyro at 1.6 kHz (the latches here are 625 µs apart), PWR_CTRL
 /// accel + gyro + temperature, ±16 g, ±2000 °/s, FIFO_CONFIG_0/1 as given.
-fn fifo_chip(config0: u8, config1: u8) -> Bmi270 {
+pub fn fifo_chip(config0: u8, config1: u8) -> Bmi270 {
     let mut c = ready_chip();
     spi_write(&mut c, 0x40, &[0xAC, 0x03, 0xAC]);
     spi_write(&mut c, 0x43, &[0x08]);
@@ -16,7 +16,7 @@ fn fifo_chip(config0: u8, config1: u8) -> Bmi270 {
     c
 }
 
-fn latch_numbered(c: &mut Bmi270, k: i16) {
+pub fn latch_numbered(c: &mut Bmi270, k: i16) {
     // accel X = k g at ±16 g reads 2048·k; gyro X = k · 10 °/s reads 164·k
     let s = PhysicalSample {
         acc: [f32::from(k) * G, 0.0, -G],
@@ -27,7 +27,7 @@ fn latch_numbered(c: &mut Bmi270, k: i16) {
     c.latch_at(&s, c.now_ns() + 625_000);
 }
 
-fn fifo_length(c: &mut Bmi270) -> usize {
+pub fn fifo_length(c: &mut Bmi270) -> usize {
     let len = read(c, 0x24, 2);
     usize::from(u16::from_le_bytes([len[0], len[1]]))
 }

@@ -12,6 +12,7 @@ mod boundary;
 mod bus;
 mod data;
 mod drivers;
+mod faults;
 mod fc;
 mod fifo;
 mod i2c;

@@ -20,7 +20,7 @@
 //!   within 400 LSB passes, else TEMP_OUT (0x41) is read again and the record passes within
 //!   800 LSB; a failing record resets the FIFO and drops the rest of the read.
 //! - [`px4_mpu9250`]: the same sequence as the MPU-9250 driver (WHO_AM_I 0x71, I2C_IF_DIS in
-//!   USER_CTRL).
+//!   USER_CTRL); a FIFO count of the whole FIFO is an overflow: FIFO reset.
 //! - [`px4_icm20602`]: PX4 `icm20602/ICM20602.cpp`: DEVICE_RESET, PWR_MGMT_1 = CLKSEL 1,
 //!   I2C_IF = I2C_IF_DIS, ACCEL_CONFIG2 = ACCEL_FCHOICE_B (4 kHz), CONFIG = FIFO_MODE |
 //!   DLPF_CFG 7 (8 kHz), GYRO_CONFIG = ±2000 °/s, ACCEL_CONFIG = ±16 g, FIFO_EN = GYRO | ACCEL,
@@ -176,9 +176,40 @@ pub fn fc_ardupilot<B: Board>(
     polls: usize,
     options: ArduPilotOptions,
 ) -> Result<FcRun, FcError> {
-    let who_am_i = read(board, 0x75, 1)[0];
-    if who_am_i != 0x68 {
-        return Err(FcError::WhoAmI(who_am_i));
+    let mut driver = ardupilot_init(board, options, 0x68)?;
+    board.loop_starts();
+    let mut run = FcRun::default();
+    for poll in 0..polls {
+        board.wait_ns(1_000_000);
+        if options.lose_byte_before_poll == Some(poll) {
+            read(board, 0x74, 1);
+        }
+        ardupilot_poll(board, &mut driver, &mut run);
+    }
+    Ok(run)
+}
+
+/// What ArduPilot's Invensense driver remembers between polls.
+#[derive(Clone, Debug)]
+pub struct ArduPilotDriver {
+    /// USER_CTRL as it last wrote it.
+    pub user_ctrl: u8,
+    /// The cached TEMP_OUT of `_check_raw_temp`.
+    pub cached_temp: i16,
+    /// The registers `start` configured, (register, value), in the order a periodic
+    /// read-back (`check_next_register`) visits them.
+    pub checked: Vec<(u8, u8)>,
+}
+
+/// ArduPilot's `_hardware_init` and `start` for a part answering `who_am_i`.
+pub fn ardupilot_init<B: Board>(
+    board: &mut B,
+    options: ArduPilotOptions,
+    who_am_i: u8,
+) -> Result<ArduPilotDriver, FcError> {
+    let got = read(board, 0x75, 1)[0];
+    if got != who_am_i {
+        return Err(FcError::WhoAmI(got));
     }
     // _hardware_init
     let mut user_ctrl = 0;
@@ -220,40 +251,50 @@ pub fn fc_ardupilot<B: Board>(
     board.wait_ns(1_000_000);
     let pin_cfg = (read(board, 0x37, 1)[0] | 0x30) & 0x02; // as the driver computes it
     write(board, 0x37, pin_cfg);
-    // _read_fifo every 1 ms
-    board.loop_starts();
-    let mut run = FcRun::default();
-    let mut cached_temp: i16 = 0;
-    for poll in 0..polls {
-        board.wait_ns(1_000_000);
-        if options.lose_byte_before_poll == Some(poll) {
-            read(board, 0x74, 1);
-        }
-        let count = u16::from_be_bytes(read(board, 0x72, 2).try_into().unwrap_or([0, 0]));
-        let mut n = usize::from(count) / 14;
-        let need_reset = n > 32;
-        if need_reset {
-            n = 24;
-        }
-        if n == 0 {
-            continue;
-        }
-        let data = read(board, 0x74, 14 * n);
-        for record in data.chunks_exact(14) {
-            let r = Record::parse(record);
-            if !ardupilot_temp_ok(board, r.temp, &mut cached_temp) {
-                user_ctrl = ardupilot_fifo_reset(board, user_ctrl);
-                run.fifo_resets += 1;
-                break;
-            }
-            run.records.push(r);
-        }
-        if need_reset {
-            user_ctrl = ardupilot_fifo_reset(board, user_ctrl);
-            run.fifo_resets += 1;
-        }
+    let checked = vec![
+        (0x6C, 0x00),
+        (0x1A, config),
+        (0x19, 0x00),
+        (0x1B, 0x18),
+        (0x1C, if rev_c { 0x08 } else { 0x18 }),
+        (0x38, 0x01),
+        (0x37, pin_cfg),
+        (0x23, 0xF8),
+        (0x6A, user_ctrl),
+    ];
+    Ok(ArduPilotDriver {
+        user_ctrl,
+        cached_temp: 0,
+        checked,
+    })
+}
+
+/// One `_read_fifo`: FIFO_COUNT, the records (each checked by `_check_raw_temp`), a FIFO
+/// reset when a record fails or more than 32 were waiting.
+pub fn ardupilot_poll<B: Board>(board: &mut B, driver: &mut ArduPilotDriver, run: &mut FcRun) {
+    let count = u16::from_be_bytes(read(board, 0x72, 2).try_into().unwrap_or([0, 0]));
+    let mut n = usize::from(count) / 14;
+    let need_reset = n > 32;
+    if need_reset {
+        n = 24;
     }
-    Ok(run)
+    if n == 0 {
+        return;
+    }
+    let data = read(board, 0x74, 14 * n);
+    for record in data.chunks_exact(14) {
+        let r = Record::parse(record);
+        if !ardupilot_temp_ok(board, r.temp, &mut driver.cached_temp) {
+            driver.user_ctrl = ardupilot_fifo_reset(board, driver.user_ctrl);
+            run.fifo_resets += 1;
+            break;
+        }
+        run.records.push(r);
+    }
+    if need_reset {
+        driver.user_ctrl = ardupilot_fifo_reset(board, driver.user_ctrl);
+        run.fifo_resets += 1;
+    }
 }
 
 /// `_check_raw_temp`: within 400 LSB of the cached TEMP_OUT passes; else re-read TEMP_OUT and
@@ -282,24 +323,44 @@ fn ardupilot_fifo_reset<B: Board>(board: &mut B, user_ctrl: u8) -> u8 {
 /// PX4's ICM-20602 driver at 8 kHz: configure, then `polls` FIFO bursts 1 ms apart, each
 /// checked for the duplicated-accel pattern. Returns the records of every transfer it accepted.
 pub fn px4_icm20602<B: Board>(board: &mut B, polls: usize) -> Result<FcRun, FcError> {
-    px4_fifo_8khz(board, polls, 0x12, (0x70, 0x40), 0x18)
+    px4_fifo_8khz(
+        board,
+        polls,
+        (0x12, 1008),
+        (0x70, 0x40),
+        0x18,
+        &mut |_, _| {},
+    )
 }
 
 /// PX4's MPU-9250 driver (`src/drivers/imu/invensense/mpu9250/MPU9250.cpp`) at 8 kHz: the
 /// ICM-20602's sequence with WHO_AM_I 0x71, I2C_IF_DIS in USER_CTRL (bit 4) and FIFO_EN
 /// naming temperature, each gyro axis and the accelerometer (the same 14-byte records).
 pub fn px4_mpu9250<B: Board>(board: &mut B, polls: usize) -> Result<FcRun, FcError> {
-    px4_fifo_8khz(board, polls, 0x71, (0x6A, 0x10), 0xF8)
+    px4_mpu9250_with(board, polls, &mut |_, _| {})
 }
 
-/// The PX4 InvenSense 8 kHz FIFO sequence for a part answering `who_am_i`, with its I2C
-/// interface disabled by `(register, value)` and `fifo_en` giving 14-byte records.
+/// [`px4_mpu9250`] calling `before_poll(board, poll)` before each poll (to inject a fault).
+pub fn px4_mpu9250_with<B: Board>(
+    board: &mut B,
+    polls: usize,
+    before_poll: &mut dyn FnMut(&mut B, usize),
+) -> Result<FcRun, FcError> {
+    px4_fifo_8khz(board, polls, (0x71, 512), (0x6A, 0x10), 0xF8, before_poll)
+}
+
+/// The PX4 InvenSense 8 kHz FIFO sequence for a part answering `who_am_i` with a FIFO of
+/// `fifo_size` bytes, with its I2C interface disabled by `(register, value)` and `fifo_en`
+/// giving 14-byte records. A count of the whole FIFO is an overflow (PX4's `FIFOReadCount`
+/// check): the driver resets the FIFO (FIFO_EN off, USER_CTRL.FIFO_RST, FIFO_EN back) and
+/// counts it in [`FcRun::fifo_resets`].
 fn px4_fifo_8khz<B: Board>(
     board: &mut B,
     polls: usize,
-    who_am_i: u8,
+    (who_am_i, fifo_size): (u8, usize),
     i2c_if_dis: (u8, u8),
     fifo_en: u8,
+    before_poll: &mut dyn FnMut(&mut B, usize),
 ) -> Result<FcRun, FcError> {
     write(board, 0x6B, 0x80);
     board.wait_ns(2_000_000);
@@ -339,9 +400,18 @@ fn px4_fifo_8khz<B: Board>(
     }
     board.loop_starts();
     let mut run = FcRun::default();
-    for _ in 0..polls {
+    for poll in 0..polls {
+        before_poll(board, poll);
         board.wait_ns(1_000_000);
         let count = u16::from_be_bytes(read(board, 0x72, 2).try_into().unwrap_or([0, 0]));
+        if usize::from(count) >= fifo_size {
+            write(board, 0x23, 0x00);
+            write(board, 0x6A, user_ctrl | 0x04);
+            write(board, 0x6A, user_ctrl | 0x40);
+            write(board, 0x23, fifo_en);
+            run.fifo_resets += 1;
+            continue;
+        }
         let samples = usize::from(count) / 14;
         if samples == 0 {
             continue;

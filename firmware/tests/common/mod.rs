@@ -8,6 +8,7 @@
 #![allow(dead_code)]
 
 pub mod fc;
+pub mod fc_faults;
 pub mod transactions;
 
 pub use transactions::*;

@@ -31,34 +31,7 @@ fn write_bank(r: &mut Recorder<impl Rig>, bank: u8, reg: u8, value: u8) {
 /// 8 kHz (`fast` = true). Every 5th poll is skipped, so reads of 2 records also happen.
 pub fn ardupilot_sequence(rig: &mut impl Rig, fast: bool, n: usize) -> Run {
     let mut r = Recorder::new(rig);
-    assert_eq!(r.read(0x75), 0x47, "WHO_AM_I");
-    fifo_reset(&mut r);
-    r.write(0x4E, 0x0F);
-    let (odr, delt, deltsqr, shift) = if fast {
-        (0x03, 21, 440u16, 6)
-    } else {
-        (0x06, 8, 64, 9)
-    };
-    r.write(0x4F, odr);
-    r.write(0x50, odr);
-    write_bank(&mut r, 1, 0x0C, delt);
-    write_bank(&mut r, 1, 0x0D, deltsqr as u8);
-    write_bank(&mut r, 1, 0x0E, shift << 4 | (deltsqr >> 8) as u8);
-    write_bank(&mut r, 2, 0x03, 5 << 1);
-    write_bank(&mut r, 2, 0x04, 25);
-    write_bank(&mut r, 2, 0x05, 10 << 4);
-    let intf_config1 = r.read(0x4D);
-    r.write(0x4D, (intf_config1 & 0x3F) | 0x40);
-    let checked = [
-        (0x16, 0x80),
-        (0x5F, 0x07),
-        (0x4C, 0xC0),
-        (0x4E, 0x0F),
-        (0x4F, odr),
-        (0x50, odr),
-        (0x4D, (intf_config1 & 0x3F) | 0x40),
-    ];
-
+    let checked = ardupilot_init(&mut r, fast);
     let period_ns = if fast { 125 * US } else { MS };
     let t0 = 50 * MS;
     r.rig.loop_starts();
@@ -77,6 +50,38 @@ pub fn ardupilot_sequence(rig: &mut impl Rig, fast: bool, n: usize) -> Run {
         r.rig.set_fast(true);
     }
     r.run
+}
+
+/// ArduPilot's `hardware_init` and `start` at 1 kHz (`fast` = false) or 8 kHz: returns its
+/// checked registers (bank 0), in the order it re-reads them.
+pub fn ardupilot_init(r: &mut Recorder<impl Rig>, fast: bool) -> [(u8, u8); 7] {
+    assert_eq!(r.read(0x75), 0x47, "WHO_AM_I");
+    fifo_reset(r);
+    r.write(0x4E, 0x0F);
+    let (odr, delt, deltsqr, shift) = if fast {
+        (0x03, 21, 440u16, 6)
+    } else {
+        (0x06, 8, 64, 9)
+    };
+    r.write(0x4F, odr);
+    r.write(0x50, odr);
+    write_bank(r, 1, 0x0C, delt);
+    write_bank(r, 1, 0x0D, deltsqr as u8);
+    write_bank(r, 1, 0x0E, shift << 4 | (deltsqr >> 8) as u8);
+    write_bank(r, 2, 0x03, 5 << 1);
+    write_bank(r, 2, 0x04, 25);
+    write_bank(r, 2, 0x05, 10 << 4);
+    let intf_config1 = r.read(0x4D);
+    r.write(0x4D, (intf_config1 & 0x3F) | 0x40);
+    [
+        (0x16, 0x80),
+        (0x5F, 0x07),
+        (0x4C, 0xC0),
+        (0x4E, 0x0F),
+        (0x4F, odr),
+        (0x50, odr),
+        (0x4D, (intf_config1 & 0x3F) | 0x40),
+    ]
 }
 
 pub fn poll(r: &mut Recorder<impl Rig>) {

@@ -45,13 +45,14 @@ pub const CONFIG: [(u8, u8, u8, u8); 22] = [
     (2, 0x04, 170, 0x55),  // ACCEL_CONFIG_STATIC3
 ];
 
-struct Px4<'a, R: Rig> {
-    r: Recorder<'a, R>,
-    bank: u8,
+/// PX4's driver state: the recorder and the bank it believes selected.
+pub struct Px4<'a, R: Rig> {
+    pub r: Recorder<'a, R>,
+    pub bank: u8,
 }
 
 impl<R: Rig> Px4<'_, R> {
-    fn select(&mut self, bank: u8) {
+    pub fn select(&mut self, bank: u8) {
         if bank != self.bank {
             self.r.write(0x76, bank);
             self.bank = bank;
@@ -79,28 +80,7 @@ impl<R: Rig> Px4<'_, R> {
 
 /// Runs PX4's reset, configuration and `n` samples at 8 kHz.
 pub fn px4_sequence(rig: &mut impl Rig, n: usize) -> Run {
-    let mut p = Px4 {
-        r: Recorder::new(rig),
-        bank: 0,
-    };
-    p.r.write(0x11, 0x01); // DEVICE_CONFIG: soft reset
-    assert_eq!(p.read(0, 0x75), 0x47);
-    assert_eq!(p.read(0, 0x11), 0x00);
-    assert_ne!(p.read(0, 0x2D) & 0x10, 0, "RESET_DONE_INT");
-    p.r.write(0x4E, 0x0F);
-    for cfg in CONFIG {
-        p.set_and_clear(cfg);
-    }
-    for cfg in CONFIG {
-        if !p.check(cfg) {
-            p.r.run.register_mismatches += 1;
-        }
-    }
-    p.select(0);
-    let flush = p.r.read(0x4B) | 0x02;
-    p.r.write(0x4B, flush);
-    p.r.rig.loop_starts();
-
+    let mut p = px4_init(rig);
     let t0 = 40 * MS;
     let (mut last_check, mut checks) = (t0, 0usize);
     for k in 0..n {
@@ -125,7 +105,35 @@ pub fn px4_sequence(rig: &mut impl Rig, n: usize) -> Run {
     p.r.run
 }
 
-fn transfer(r: &mut Recorder<impl Rig>, bytes: &[u8]) {
+/// PX4's reset, configuration, check and FIFO flush, up to its sampling loop.
+pub fn px4_init<R: Rig>(rig: &mut R) -> Px4<'_, R> {
+    let mut p = Px4 {
+        r: Recorder::new(rig),
+        bank: 0,
+    };
+    p.r.write(0x11, 0x01); // DEVICE_CONFIG: soft reset
+    assert_eq!(p.read(0, 0x75), 0x47);
+    assert_eq!(p.read(0, 0x11), 0x00);
+    assert_ne!(p.read(0, 0x2D) & 0x10, 0, "RESET_DONE_INT");
+    p.r.write(0x4E, 0x0F);
+    for cfg in CONFIG {
+        p.set_and_clear(cfg);
+    }
+    for cfg in CONFIG {
+        if !p.check(cfg) {
+            p.r.run.register_mismatches += 1;
+        }
+    }
+    p.select(0);
+    let flush = p.r.read(0x4B) | 0x02;
+    p.r.write(0x4B, flush);
+    p.r.rig.loop_starts();
+    p
+}
+
+/// PX4's `FIFORead` of one burst from INT_STATUS: an overflow (FIFO_FULL_INT, or a count of
+/// the whole FIFO) or a bad header counts a FIFO reset and drops the burst.
+pub fn transfer(r: &mut Recorder<impl Rig>, bytes: &[u8]) {
     let (status, count) = (bytes[0], u16::from_be_bytes([bytes[1], bytes[2]]));
     if status & 0x02 != 0 || usize::from(count) >= 2048 {
         r.run.fifo_resets += 1;

@@ -7,8 +7,10 @@
 
 #![allow(missing_docs)]
 
+mod afsr;
 mod bus;
 mod data;
+mod faults;
 mod fc;
 mod fc_ardupilot;
 mod fc_betaflight;

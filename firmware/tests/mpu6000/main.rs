@@ -8,6 +8,7 @@
 mod common;
 
 mod accel_rate;
+mod faults;
 mod fc_sequences;
 mod fifo;
 mod identity;

@@ -11,6 +11,7 @@ mod aux_master;
 mod bus_i2c;
 mod bus_spi;
 mod data;
+mod faults;
 mod fifo;
 mod interrupts;
 mod magnetometer;

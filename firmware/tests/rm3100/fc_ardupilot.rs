@@ -4,7 +4,8 @@
 //! cycle-count bytes again, all eight kept for its register check. Every 12.5 ms (80 Hz) it
 //! reads STATUS and, when bit 7 is set, 9 bytes from 0x24 (24-bit big-endian, 75 LSB/µT).
 //! Every tenth call its register check reads the next of the eight registers (a second time if
-//! it differs) and writes the expected value back on a mismatch.
+//! it differs) and writes the expected value back on a mismatch, which is how it recovers from
+//! a reset of the chip (`Chip::fault_reset`).
 
 use margemu_protocol::regmap::rm3100::continuous_period_ns;
 
@@ -73,6 +74,17 @@ impl ArduPilot {
 /// [`Bench`] does. Returns the driver and, for each call, the sample
 /// the chip's last completed sequence measured (if any).
 fn run(link: Link, strict: bool, calls: u64) -> (ArduPilot, Vec<Option<usize>>) {
+    run_with_reset(link, strict, calls, None).0
+}
+
+/// [`run`] with a reset fault (`Chip::fault_reset`) before timer call `reset_at`; also returns
+/// the call at which each reading was taken.
+fn run_with_reset(
+    link: Link,
+    strict: bool,
+    calls: u64,
+    reset_at: Option<u64>,
+) -> ((ArduPilot, Vec<Option<usize>>), Vec<u64>) {
     const T_CFG: u64 = MS;
     let mut mag = Rm3100::new();
     mag.set_strict_cmm(strict);
@@ -82,15 +94,20 @@ fn run(link: Link, strict: bool, calls: u64) -> (ArduPilot, Vec<Option<usize>>) 
     let period = continuous_period_ns(0x94, 0b111, [200; 3]);
     assert_eq!(period, MEAS_3X200);
     let mut bench = Bench::new(T_CFG, period, T_CFG + calls * TIMER_NS);
-    let mut expected = Vec::new();
+    let (mut expected, mut at) = (Vec::new(), Vec::new());
     for j in 1..=calls {
         let t = T_CFG + j * TIMER_NS;
+        if reset_at == Some(j) {
+            assert!(margemu_firmware::chip::Chip::fault_reset(&mut mag));
+        }
         bench.run_to(&mut mag, t);
         // Sequence k completes at T_CFG + (k + 1) · period.
         expected.push(((t - T_CFG) / period).checked_sub(1).map(|k| k as usize));
+        let before = ap.readings.len();
         ap.timer(&mut mag);
+        at.extend((before..ap.readings.len()).map(|_| j));
     }
-    (ap, expected)
+    ((ap, expected), at)
 }
 
 #[test]
@@ -142,5 +159,46 @@ fn a_chip_with_other_cycle_counts_is_not_probed() {
         i2c_read(&mut other, ADDRESS, 0x04, 1),
         None,
         "0x21 does not answer 0x20"
+    );
+}
+
+/// A reset mid-run (the chip idle at its power-on values: CMM 0, TMRC 0x96) stops the data;
+/// ArduPilot's register check finds TMRC and CMM changed and writes them back, which restarts
+/// continuous mode: the readings resume, in order and exact, without a re-probe.
+#[test]
+fn the_register_check_notices_a_reset_and_its_rewrite_of_cmm_restarts_the_data() {
+    let ((clean, _), _) = run_with_reset(Link::I2c(ADDRESS), false, 200, None);
+    assert_eq!(clean.rewrites, 0);
+    let ((ap, expected), at) = run_with_reset(Link::I2c(ADDRESS), false, 200, Some(55));
+    assert_eq!(ap.rewrites, 2, "TMRC and CMM written back");
+    let fields = samples(400);
+    assert_eq!(
+        ap.readings[..54],
+        clean.readings[..54],
+        "exact before the reset"
+    );
+    let gap: Vec<u64> = at
+        .windows(2)
+        .filter(|w| w[1] - w[0] > 1)
+        .map(|w| w[0])
+        .collect();
+    assert_eq!(gap, [54], "one gap, from the reset to the CMM rewrite");
+    let resumed = *at.iter().find(|&&j| j > 55).unwrap();
+    // Continuous mode restarts at the rewrite, on its own schedule: each reading after it is
+    // exactly one of the samples (within one LSB), newer than the last, and none latched after
+    // the call (the bench latches sample `e + 1` at the instant sequence `e` completes).
+    let mut last = 0;
+    for (raw, &j) in ap.readings.iter().zip(&at).filter(|(_, &j)| j >= resumed) {
+        let k = fields
+            .iter()
+            .position(|f| within_one_lsb(*raw, *f, [200; 3]))
+            .expect("a latched sample");
+        let latched = expected[(j - 1) as usize].map_or(0, |e| e + 1);
+        assert!(k > last && k <= latched, "call {j}: sample {k}");
+        last = k;
+    }
+    assert!(
+        resumed <= 55 + 8 * 10 + 10,
+        "within one round of checks: call {resumed}"
     );
 }

@@ -39,6 +39,7 @@ use super::super::spi_phase::SpiRegisters;
 use super::super::write_log::{Bus, RegisterWrite, WriteLog};
 use super::super::PhysicalSample;
 use super::accel_fifo::AccelFifo;
+use super::faults::DieFaults;
 use super::i2c::{I2cPort, I2cRegisters};
 use super::{pin_level, put_le, Regs, WRITE_LOG_LEN};
 
@@ -69,6 +70,8 @@ pub struct Bmi088Accel {
     temp_at: Option<u64>,
     now_ns: u64,
     log: WriteLog<WRITE_LOG_LEN>,
+    /// The fault hooks' overrides (`faults.rs`), kept across resets.
+    pub(super) fault: DieFaults,
 }
 
 impl Default for Bmi088Accel {
@@ -98,6 +101,7 @@ impl Bmi088Accel {
             temp_at: None,
             now_ns: 0,
             log: WriteLog::new(),
+            fault: DieFaults::default(),
         }
     }
 
@@ -172,6 +176,9 @@ impl Bmi088Accel {
             let downs = (self.regs.get(reg::FIFO_DOWNS) >> 4) & 0x07;
             let stop = self.regs.get(reg::FIFO_CONFIG_0) & bits::FIFO_MODE_STOP != 0;
             self.fifo.push_sample(&data, downs, stop);
+            if self.fault.fifo_overflow {
+                self.fifo.overflow_with(&data, stop);
+            }
         }
         let latch = Latch { data, temp };
         if self.spi.is_active() || self.i2c != I2cPort::Idle {
@@ -271,6 +278,7 @@ impl Bmi088Accel {
                 }
             }
             reg::ACC_SOFTRESET => 0,
+            reg::CHIP_ID => self.fault.chip_id.unwrap_or(self.regs.get(addr)),
             _ => self.regs.get(addr),
         }
     }

@@ -93,6 +93,20 @@ impl AccelFifo {
         if !due {
             return;
         }
+        self.push_frame(data, stop_on_full);
+    }
+
+    /// The overflow fault: frames of `data` until the FIFO is full, then one more, which is
+    /// lost (or makes room, in stream mode) and counts in the next skip frame.
+    pub(super) fn overflow_with(&mut self, data: &[u8; 6], stop_on_full: bool) {
+        while !self.is_full() {
+            self.push_frame(data, stop_on_full);
+        }
+        self.push_frame(data, stop_on_full);
+    }
+
+    /// Appends one frame of `data`, making room or dropping it when full.
+    fn push_frame(&mut self, data: &[u8; 6], stop_on_full: bool) {
         if self.is_full() {
             self.skipped = self.skipped.saturating_add(1);
             if stop_on_full {

@@ -30,6 +30,18 @@ fn i2c_write(die: &mut impl I2cTarget, address: u8, register: u8, value: u8) -> 
 }
 
 impl Chip for Bmi088 {
+    fn fault_reset(&mut self) -> bool {
+        Bmi088::fault_reset(self);
+        true
+    }
+    fn fault_identity(&mut self, value: Option<u8>) -> bool {
+        Bmi088::fault_identity(self, value);
+        true
+    }
+    fn fault_fifo_overflow(&mut self, on: bool) -> bool {
+        Bmi088::fault_fifo_overflow(self, on);
+        true
+    }
     fn model(&self) -> ChipModel {
         ChipModel::Bmi088
     }

@@ -35,6 +35,7 @@ use margemu_protocol::regmap::bmi088::Die;
 use super::super::spi_phase::{SpiPhase, SpiRegisters};
 use super::super::write_log::{Bus, RegisterWrite, WriteLog};
 use super::super::{PhysicalSample, SpiTarget};
+use super::faults::DieFaults;
 use super::gyro_fifo::GyroFifo;
 use super::i2c::{I2cPort, I2cRegisters};
 use super::{pin_level, put_le, Regs, WRITE_LOG_LEN};
@@ -60,6 +61,8 @@ pub struct Bmi088Gyro {
     bist_done: bool,
     now_ns: u64,
     log: WriteLog<WRITE_LOG_LEN>,
+    /// The fault hooks' overrides (`faults.rs`), kept across resets.
+    pub(super) fault: DieFaults,
 }
 
 impl Default for Bmi088Gyro {
@@ -88,6 +91,7 @@ impl Bmi088Gyro {
             bist_done: false,
             now_ns: 0,
             log: WriteLog::new(),
+            fault: DieFaults::default(),
         }
     }
 
@@ -198,6 +202,9 @@ impl Bmi088Gyro {
             }
         };
         self.fifo.push(frame, len, stream);
+        if self.fault.fifo_overflow {
+            self.fifo.overflow_with(frame, len, stream);
+        }
     }
 
     fn data_int(&self) -> bool {
@@ -257,6 +264,7 @@ impl Bmi088Gyro {
                 ok | rdy
             }
             reg::FIFO_DATA => self.fifo.peek(),
+            reg::CHIP_ID => self.fault.chip_id.unwrap_or(self.regs.get(addr)),
             _ => self.regs.get(addr),
         }
     }

@@ -74,6 +74,15 @@ impl GyroFifo {
         self.frame_len = len.clamp(1, 6);
     }
 
+    /// The overflow fault: copies of `frame` until the FIFO is full, then one more, which
+    /// overruns.
+    pub(super) fn overflow_with(&mut self, frame: [u8; 6], len: usize, stream: bool) {
+        while self.count < Self::capacity(stream) {
+            self.push(frame, len, stream);
+        }
+        self.push(frame, len, stream);
+    }
+
     fn drop_front(&mut self) {
         if self.count > 0 {
             self.head = (self.head + 1) % FIFO_FRAMES;

@@ -27,6 +27,9 @@
 //! the accel at its own ODR. Register file 0 is the accelerometer, file 1 the gyroscope
 //! (`boundary.rs`).
 //!
+//! **Faults** (`faults.rs`): the [`Chip`](super::Chip) fault hooks on both dies — power
+//! cycles, wrong CHIP_IDs, FIFOs forced to overflow.
+//!
 //! Driver sequences read (no code taken): PX4 `src/drivers/imu/bosch/bmi088/`
 //! (`BMI088_Accelerometer.cpp`, `BMI088_Gyroscope.cpp`), ArduPilot
 //! `libraries/AP_InertialSensor/AP_InertialSensor_BMI088.cpp`, the Rust `bmi088` crate 0.2.1 and
@@ -59,6 +62,7 @@
 pub mod accel;
 pub mod accel_fifo;
 mod boundary;
+mod faults;
 pub mod gyro;
 pub mod gyro_fifo;
 mod i2c;

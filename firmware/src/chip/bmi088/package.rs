@@ -151,6 +151,11 @@ impl Bmi088 {
             .unwrap_or_else(|| Bandwidth::from_reg(self.gyro.peek(gyr_reg::BANDWIDTH)).period_ns())
     }
 
+    /// The accelerometer's rate divider starts over (after a power cycle).
+    pub(super) fn restart_accel_clock(&mut self) {
+        self.accel_tick = (Tick::default(), 0);
+    }
+
     /// Whether an accel sample is due at `now_ns` at `period` (the divider restarts when the
     /// period changes).
     fn accel_takes(&mut self, now_ns: u64, period: u64) -> bool {

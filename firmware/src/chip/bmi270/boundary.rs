@@ -25,6 +25,18 @@ const WRITE_SIDE_EFFECTS: [u8; 5] = [
 ];
 
 impl Chip for Bmi270 {
+    fn fault_reset(&mut self) -> bool {
+        Bmi270::fault_reset(self);
+        true
+    }
+    fn fault_identity(&mut self, value: Option<u8>) -> bool {
+        Bmi270::fault_identity(self, value);
+        true
+    }
+    fn fault_fifo_overflow(&mut self, on: bool) -> bool {
+        Bmi270::fault_fifo_overflow(self, on);
+        true
+    }
     fn model(&self) -> ChipModel {
         ChipModel::Bmi270
     }

@@ -180,7 +180,18 @@ impl Bmi270 {
         }
         let frame = frame.get(..n).unwrap_or(&[]);
         let stop_on_full = self.stored(reg::FIFO_CONFIG_0) & bits::FIFO_STOP_ON_FULL != 0;
-        if !self.fifo.push(frame) && !stop_on_full {
+        let mut fits = self.fifo.push(frame);
+        // The overflow fault: copies of the frame until one does not fit (`faults.rs`).
+        let mut copies = if self.fault.fifo_overflow {
+            MAX_FRAMES + 1
+        } else {
+            0
+        };
+        while fits && copies > 0 {
+            fits = self.fifo.push(frame);
+            copies -= 1;
+        }
+        if !fits && !stop_on_full {
             let err = self.stored(reg::ERR_REG) | bits::FIFO_ERR;
             self.set(reg::ERR_REG, err);
         }

@@ -58,6 +58,9 @@
 //! (FIFO_DOWNS), FIFO_LENGTH_0/1 in bytes, FIFO_DATA (a frame leaves once read whole), ERR_REG
 //! fifo_err on a stream-mode overflow, CMD 0xB0 flush.
 //!
+//! **Faults** (`faults.rs`): the [`Chip`](super::Chip) fault hooks — a power cycle (the
+//! upload lost), a wrong CHIP_ID, a FIFO forced to overflow.
+//!
 //! **Interrupts** (`interrupts.rs`): data ready sets INT_STATUS_1 acc_drdy / gyr_drdy and, mapped
 //! by INT_MAP_DATA, drives INT1/INT2 as INTx_IO_CTRL says, pulsed or latched (INT_LATCH).
 //!
@@ -101,6 +104,7 @@
 //! ```
 
 mod boundary;
+mod faults;
 mod fifo;
 mod i2c;
 mod interrupts;
@@ -117,6 +121,7 @@ pub use margemu_protocol::regmap::bmi270::CONFIG_FILE_LENS;
 use super::bosch_spi::BoschSpi;
 use super::write_log::{RegisterWrite, WriteLog};
 use super::PhysicalSample;
+use faults::FaultState;
 use fifo::Fifo;
 use i2c::I2cState;
 use interrupts::Interrupts;
@@ -159,6 +164,8 @@ pub struct Bmi270 {
     spi: BoschSpi,
     i2c: I2cState,
     log: WriteLog<WRITE_LOG_LEN>,
+    /// The fault hooks' overrides (`faults.rs`), kept across resets.
+    fault: FaultState,
 }
 
 impl Default for Bmi270 {
@@ -190,6 +197,7 @@ impl Bmi270 {
             spi: BoschSpi::new(),
             i2c: I2cState::default(),
             log: WriteLog::new(),
+            fault: FaultState::default(),
         };
         chip.soft_reset();
         chip

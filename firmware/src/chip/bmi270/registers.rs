@@ -63,6 +63,7 @@ impl Bmi270 {
             reg::INT_STATUS_1 => self.int_status_1(),
             reg::FIFO_DATA => self.fifo.peek().unwrap_or(bits::FIFO_EMPTY),
             reg::CMD | reg::INIT_DATA => 0,
+            reg::CHIP_ID => self.fault.chip_id.unwrap_or(self.stored(addr)),
             _ => self.stored(addr),
         }
     }

@@ -107,6 +107,18 @@ impl Chip for Icm42688p {
     fn burst_start(&self) -> u8 {
         bank0::TEMP_DATA1
     }
+    fn fault_reset(&mut self) -> bool {
+        Icm42688p::fault_reset(self);
+        true
+    }
+    fn fault_identity(&mut self, value: Option<u8>) -> bool {
+        Icm42688p::fault_identity(self, value);
+        true
+    }
+    fn fault_fifo_overflow(&mut self, on: bool) -> bool {
+        Icm42688p::fault_fifo_overflow(self, on);
+        true
+    }
     /// FIFO_DATA pops and FIFO_COUNTH latches the count: the burst runs on a copy.
     fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
         spi_read_burst_on_copy(self, start, out);

@@ -187,10 +187,19 @@ impl Icm42688p {
         };
         let records = self.reg0(bank0::INTF_CONFIG0) & bits::FIFO_COUNT_REC != 0;
         let before = self.fifo_count(records);
-        let lost = self.fifo.push(
-            out.get(..n).unwrap_or_default(),
-            mode == bits::FIFO_MODE_STREAM,
-        );
+        let packet = out.get(..n).unwrap_or_default();
+        let stream = mode == bits::FIFO_MODE_STREAM;
+        let mut lost = self.fifo.push(packet, stream);
+        // The overflow fault: copies of the packet until one does not fit (`faults.rs`).
+        let mut copies = if self.fault.fifo_overflow {
+            MAX_PACKETS + 1
+        } else {
+            0
+        };
+        while lost == 0 && copies > 0 {
+            lost = self.fifo.push(packet, stream);
+            copies -= 1;
+        }
         if lost > 0 || self.fifo.bytes() == FIFO_SIZE {
             self.raise_interrupt(bits::FIFO_FULL_INT);
         }

@@ -21,10 +21,16 @@
 //! pulse (INT_CONFIG1) per event, active high or low (INT_CONFIG). Time only moves with the
 //! latches and [`Icm42688p::advance`].
 //!
+//! **AFSR** (`afsr.rs`): left on (INTF_CONFIG1 bits 7:6 ≠ 01, as at power-on), a gyro axis
+//! whose rate crosses ±[`AFSR_THRESHOLD_DPS`] holds its output for [`AFSR_STALL_NS`], as the
+//! silicon does; drivers that turn AFSR off never see it.
+//!
+//! **Faults** (`faults.rs`): the [`Chip`](super::Chip) fault hooks — a power cycle, a wrong
+//! WHO_AM_I, a FIFO forced to overflow.
+//!
 //! **Stored only** (read back, no effect on the data yet): the anti-alias filters (bank 1
 //! 0x0B–0x0E, bank 2 0x03–0x05), the notch filter, the UI filters (GYRO_CONFIG1,
-//! GYRO_ACCEL_CONFIG0, ACCEL_CONFIG1), AFSR (INTF_CONFIG1 bits 7:6: the emulated gyro never
-//! stalls), clock selection and the external clock, APEX, wake on motion, self-test, FSYNC and
+//! GYRO_ACCEL_CONFIG0, ACCEL_CONFIG1), clock selection and the external clock, APEX, wake on motion, self-test, FSYNC and
 //! the user offsets (bank 4). Register writes are logged with the register address only; the
 //! REG_BANK_SEL writes in the log tell which bank they reached.
 //!
@@ -47,7 +53,9 @@
 //! assert_eq!(spi(&mut chip, &[0x80 | 0x23, 0x00, 0x00])[1..], [0x08, 0x00]); // ACCEL_DATA_Z: 2048
 //! ```
 
+mod afsr;
 mod boundary;
+mod faults;
 mod fifo;
 mod i2c;
 mod interrupts;
@@ -62,7 +70,11 @@ use super::write_log::{RegisterWrite, WriteLog};
 use super::PhysicalSample;
 
 use super::spi_phase::SpiPhase;
+use afsr::Afsr;
+use faults::FaultState;
 use fifo::Fifo;
+
+pub use afsr::{AFSR_STALL_NS, AFSR_THRESHOLD_DPS};
 use i2c::I2cState;
 use interrupts::Pulse;
 
@@ -107,6 +119,10 @@ pub struct Icm42688p {
     spi: SpiPhase,
     i2c: I2cState,
     log: WriteLog<WRITE_LOG_LEN>,
+    /// The gyro's AFSR state (`afsr.rs`).
+    afsr: Afsr,
+    /// The fault hooks' overrides (`faults.rs`), kept across resets.
+    fault: FaultState,
 }
 
 impl Default for Icm42688p {
@@ -137,19 +153,23 @@ impl Icm42688p {
             spi: SpiPhase::Idle,
             i2c: I2cState::default(),
             log: WriteLog::new(),
+            afsr: Afsr::default(),
+            fault: FaultState::default(),
         };
         chip.soft_reset();
         chip
     }
 
-    /// Power cycle: registers and bus state as from [`Icm42688p::with_config`]; the clock and
-    /// the write log are kept.
+    /// Power cycle: registers and bus state as from [`Icm42688p::with_config`]; the clock, the
+    /// write log and the fault hooks' overrides are kept.
     pub fn power_cycle(&mut self) {
         let now_ns = self.now_ns;
         let log = core::mem::take(&mut self.log);
+        let fault = self.fault;
         *self = Self::with_config(self.config);
         self.now_ns = now_ns;
         self.log = log;
+        self.fault = fault;
     }
 
     /// The configuration the chip was built with.

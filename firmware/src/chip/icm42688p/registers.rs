@@ -43,6 +43,7 @@ impl Icm42688p {
         self.int2 = Default::default();
         self.fifo.flush();
         self.fifo_count_latch = [0; 2];
+        self.afsr = Default::default();
         self.raise_interrupt(bits::RESET_DONE_INT);
     }
 
@@ -99,7 +100,7 @@ impl Icm42688p {
             bank0::FIFO_DATA => self.fifo.peek().unwrap_or(0xFF),
             bank0::FIFO_LOST_PKT0 => self.fifo.lost().to_le_bytes()[0],
             bank0::FIFO_LOST_PKT1 => self.fifo.lost().to_le_bytes()[1],
-            bank0::WHO_AM_I => self.config.who_am_i,
+            bank0::WHO_AM_I => self.fault.who_am_i.unwrap_or(self.config.who_am_i),
             _ => self.stored(0, addr),
         }
     }

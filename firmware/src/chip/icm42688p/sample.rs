@@ -5,6 +5,7 @@
 //! A sensor that is off (PWR_MGMT0: gyro not in low-noise mode, accel not in a low-power or
 //! low-noise mode, temperature disabled or both off) reads −32768 (0x8000), in the data
 //! registers and in the FIFO (20-bit: −524288). Turning a sensor off writes 0x8000 at once.
+//! A running gyro's new values pass through AFSR (`afsr.rs`), which may hold an axis.
 
 use margemu_protocol::regmap::icm42688p::convert::{INVALID16, INVALID20};
 use margemu_protocol::regmap::icm42688p::image::{field, ImageRepr, IMAGE_LEN};
@@ -44,7 +45,11 @@ impl Icm42688p {
         if !self.accel_on() {
             hires[..3].fill(INVALID20);
         }
-        if !self.gyro_on() {
+        if self.gyro_on() {
+            let mut gyro20 = [hires[3], hires[4], hires[5]];
+            self.afsr_apply(&mut data, &mut gyro20);
+            hires[3..].copy_from_slice(&gyro20);
+        } else {
             hires[3..].fill(INVALID20);
         }
         self.fifo_push_sample(&PacketSource { data: &data, hires });

@@ -117,6 +117,18 @@ impl Chip for Mpu6xxx {
     fn spi_read_burst(&self, start: u8, out: &mut [u8]) {
         spi_read_burst_on_copy(self, start, out);
     }
+    fn fault_reset(&mut self) -> bool {
+        Mpu6xxx::fault_reset(self);
+        true
+    }
+    fn fault_identity(&mut self, value: Option<u8>) -> bool {
+        Mpu6xxx::fault_identity(self, value);
+        true
+    }
+    fn fault_fifo_overflow(&mut self, on: bool) -> bool {
+        Mpu6xxx::fault_fifo_overflow(self, on);
+        true
+    }
     /// The own address unless USER_CTRL.I2C_IF_DIS; the AK8963's in bypass mode.
     fn i2c_addresses_now(&self) -> [Option<u8>; 2] {
         let interface_on = self.peek(reg::USER_CTRL) & bits::USER_I2C_IF_DIS == 0;

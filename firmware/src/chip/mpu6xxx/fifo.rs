@@ -46,6 +46,11 @@ impl Fifo {
         self.len as u16
     }
 
+    /// The part's FIFO size in bytes.
+    pub(super) fn capacity(&self) -> u16 {
+        self.capacity as u16
+    }
+
     pub(super) fn clear(&mut self) {
         self.head = 0;
         self.len = 0;

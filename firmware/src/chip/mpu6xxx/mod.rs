@@ -51,6 +51,7 @@
 
 mod aux_master;
 mod boundary;
+mod faults;
 mod fifo;
 mod i2c;
 mod registers;
@@ -68,6 +69,7 @@ use super::PhysicalSample;
 
 use super::spi_phase::SpiPhase;
 use aux_master::AuxState;
+use faults::FaultState;
 use fifo::Fifo;
 use i2c::I2cState;
 
@@ -140,6 +142,8 @@ pub struct Mpu6xxx {
     spi: SpiPhase,
     i2c: I2cState,
     log: WriteLog<WRITE_LOG_LEN>,
+    /// The fault hooks' overrides (`faults.rs`), kept across resets.
+    fault: FaultState,
 }
 
 impl Default for Mpu6xxx {
@@ -178,21 +182,30 @@ impl Mpu6xxx {
             spi: SpiPhase::Idle,
             i2c: I2cState::default(),
             log: WriteLog::new(),
+            fault: FaultState::default(),
         };
         chip.device_reset();
         chip
     }
 
-    /// Power cycle: both dies and the bus state as from [`Mpu6xxx::with_config`]; the clock and the
-    /// write log are kept.
+    /// Power cycle: both dies and the bus state as from [`Mpu6xxx::with_config`]; the clock, the
+    /// write log and the fault hooks' overrides are kept (the AK8963 keeps sensing the field it
+    /// held).
     pub fn power_cycle(&mut self) {
         let now_ns = self.now_ns;
         let log = core::mem::take(&mut self.log);
+        let fault = self.fault;
+        let source = self.ak.as_ref().map(Ak8963::held_source);
         *self = Self::with_config(self.config);
         self.now_ns = now_ns;
         self.log = log;
+        self.fault = fault;
         if let Some(ak) = &mut self.ak {
-            ak.advance(now_ns, super::MagSource::Physical([0.0; 3]));
+            ak.fault_identity(fault.who_am_i);
+            ak.advance(
+                now_ns,
+                source.unwrap_or(super::MagSource::Physical([0.0; 3])),
+            );
         }
     }
 

@@ -64,7 +64,10 @@ impl Mpu6xxx {
             reg::FIFO_COUNTH => (self.fifo.len() >> 8) as u8 & 0x1F,
             reg::FIFO_COUNTL => self.fifo_count_latch as u8,
             reg::FIFO_R_W => self.fifo.peek(),
-            reg::WHO_AM_I => self.config.variant.who_am_i(),
+            reg::WHO_AM_I => self
+                .fault
+                .who_am_i
+                .unwrap_or(self.config.variant.who_am_i()),
             reg::MEM_R_W => 0x00, // DMP memory is not emulated
             _ => self.regs[usize::from(addr)],
         }

@@ -84,6 +84,9 @@ impl Mpu6xxx {
         }
         self.aux_sample(&mut data[SENSOR_LEN..]);
         self.fifo_push_record(&data);
+        if self.fault.fifo_overflow {
+            self.fifo_fill(&data);
+        }
         self.raise_interrupt(bits::INT_RAW_RDY);
         self.publish_data(data);
     }

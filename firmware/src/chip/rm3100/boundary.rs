@@ -11,6 +11,18 @@ use super::super::{spi_read_burst_on_copy, Chip, I2cTarget, RegisterWrite};
 use super::Rm3100;
 
 impl Chip for Rm3100 {
+    fn fault_reset(&mut self) -> bool {
+        Rm3100::fault_reset(self);
+        true
+    }
+    fn fault_identity(&mut self, value: Option<u8>) -> bool {
+        Rm3100::fault_identity(self, value);
+        true
+    }
+    /// The RM3100 has no FIFO (one result set in its registers): nothing can overflow.
+    fn fault_fifo_overflow(&mut self, _on: bool) -> bool {
+        false
+    }
     fn model(&self) -> ChipModel {
         ChipModel::Rm3100
     }

@@ -114,6 +114,8 @@ pub struct Rm3100 {
     results_read: bool,
     spi: SpiPhase,
     log: WriteLog<RM3100_WRITE_LOG_LEN>,
+    /// What REVID reads under the wrong-identity fault (kept across resets).
+    identity: Option<u8>,
 }
 
 /// Register writes the RM3100 keeps for the link.
@@ -168,7 +170,35 @@ impl Rm3100 {
             results_read: false,
             spi: SpiPhase::Idle,
             log: WriteLog::new(),
+            identity: None,
         }
+    }
+
+    /// The reset fault (`margemu_model::fault::FaultKind::Reset`): the power-on state (the
+    /// RM3100 has no soft reset; DS §5.6: POLL and CMM 0, cycle counts 200, TMRC 0x96, HSHAKE
+    /// 0x1B): idle, DRDY clear, the results 0, the register pointer at 0. The clock, the held
+    /// field, the bus transaction in progress, the write log, the strict-CMM setting and a
+    /// wrong-identity override are kept. A driver in continuous mode stops getting data; its
+    /// read-back of CMM, the cycle counts or TMRC (ArduPilot's RM3100 driver checks CMM)
+    /// sees the difference.
+    pub fn fault_reset(&mut self) {
+        *self = Self {
+            address: self.address,
+            now_ns: self.now_ns,
+            held: self.held,
+            strict_cmm: self.strict_cmm,
+            expect_register: self.expect_register,
+            addressed: self.addressed,
+            spi: self.spi,
+            log: core::mem::take(&mut self.log),
+            identity: self.identity,
+            ..Self::new()
+        };
+    }
+
+    /// The wrong-identity fault: REVID reads `value` until `None`.
+    pub fn fault_identity(&mut self, value: Option<u8>) {
+        self.identity = value;
     }
 
     /// The 7-bit I2C address the chip answers.
@@ -217,7 +247,7 @@ impl Rm3100 {
             reg::BIST => self.bist,
             reg::STATUS if self.drdy => bits::STATUS_DRDY,
             reg::HSHAKE => bits::HSHAKE_ONE | self.nack | self.drc,
-            reg::REVID => map::REVID_VALUE,
+            reg::REVID => self.identity.unwrap_or(map::REVID_VALUE),
             _ => 0x00, // STATUS without DRDY, unmapped addresses
         }
     }
