@@ -222,12 +222,25 @@ mod tests {
         let v = [0.1f32, -2.5, f32::MIN_POSITIVE];
         let s = Sensor::Mag;
         [
-            FaultKind::Stuck { sensor: Sensor::Acc },
-            FaultKind::StuckAt { sensor: Sensor::Gyr, value: v },
+            FaultKind::Stuck {
+                sensor: Sensor::Acc,
+            },
+            FaultKind::StuckAt {
+                sensor: Sensor::Gyr,
+                value: v,
+            },
             FaultKind::Dropout { sensor: s },
-            FaultKind::Spikes { sensor: s, rate_hz: 12.5, amplitude: -3.0, axes: 0b101 },
+            FaultKind::Spikes {
+                sensor: s,
+                rate_hz: 12.5,
+                amplitude: -3.0,
+                axes: 0b101,
+            },
             FaultKind::BiasStep { sensor: s, bias: v },
-            FaultKind::Scale { sensor: s, factor: v },
+            FaultKind::Scale {
+                sensor: s,
+                factor: v,
+            },
             FaultKind::Noise { sensor: s, std: v },
             FaultKind::MagSaturation { field: v },
             FaultKind::Reset,
@@ -235,8 +248,13 @@ mod tests {
             FaultKind::FifoOverflow,
             FaultKind::Nak,
             FaultKind::Corrupt { probability: 0.01 },
-            FaultKind::ClockStretch { stretch_ns: 150_000 },
-            FaultKind::ClockOffset { ppm: 200.0, drift_ppm_per_s: -1.5 },
+            FaultKind::ClockStretch {
+                stretch_ns: 150_000,
+            },
+            FaultKind::ClockOffset {
+                ppm: 200.0,
+                drift_ppm_per_s: -1.5,
+            },
             FaultKind::DrdyJitter { max_ns: 40_000 },
             FaultKind::MissingDrdy { probability: 0.25 },
             FaultKind::Late { delay_ns: 300_000 },
@@ -265,7 +283,10 @@ mod tests {
             assert_eq!(Message::parse(0x07, &bytes).unwrap(), msg);
             // Every truncation and extension is refused.
             for n in 0..bytes.len() {
-                assert!(Message::parse(0x07, &bytes[..n]).is_err(), "{n} of {kind:?}");
+                assert!(
+                    Message::parse(0x07, &bytes[..n]).is_err(),
+                    "{n} of {kind:?}"
+                );
             }
             let mut long = bytes.clone();
             long.push(0).unwrap();
@@ -275,24 +296,43 @@ mod tests {
         // A NaN's payload bits survive.
         let nan = f32::from_bits(0x7FC0_1234);
         let kind = FaultKind::Corrupt { probability: nan };
-        let msg = AddFault { fault: Fault::new(0, Window::new(0, 1), kind), seed: 1 };
+        let msg = AddFault {
+            fault: Fault::new(0, Window::new(0, 1), kind),
+            seed: 1,
+        };
         let bytes = emit(&Message::AddFault(msg));
-        let Ok(Message::AddFault(back)) = Message::parse(0x07, &bytes) else { panic!() };
-        let FaultKind::Corrupt { probability } = back.fault.kind else { panic!() };
+        let Ok(Message::AddFault(back)) = Message::parse(0x07, &bytes) else {
+            panic!()
+        };
+        let FaultKind::Corrupt { probability } = back.fault.kind else {
+            panic!()
+        };
         assert_eq!(probability.to_bits(), 0x7FC0_1234);
     }
 
     #[test]
     fn malformed_values_are_refused() {
-        let kind = FaultKind::Spikes { sensor: Sensor::Gyr, rate_hz: 1.0, amplitude: 1.0, axes: 1 };
-        let msg = Message::AddFault(AddFault { fault: Fault::new(0, Window::new(10, 20), kind), seed: 3 });
+        let kind = FaultKind::Spikes {
+            sensor: Sensor::Gyr,
+            rate_hz: 1.0,
+            amplitude: 1.0,
+            axes: 1,
+        };
+        let msg = Message::AddFault(AddFault {
+            fault: Fault::new(0, Window::new(10, 20), kind),
+            seed: 3,
+        });
         let bytes = emit(&msg);
         // An unknown kind, an unknown sensor, axes beyond z, an empty and a reversed window.
         let edits: [(usize, u8); 5] = [(25, 18), (26, 3), (35, 8), (9, 20), (9, 30)];
         for (at, value) in edits {
             let mut m = bytes.clone();
             m[at] = value;
-            assert_eq!(Message::parse(0x07, &m), Err(Error::InvalidValue), "{at} = {value}");
+            assert_eq!(
+                Message::parse(0x07, &m),
+                Err(Error::InvalidValue),
+                "{at} = {value}"
+            );
         }
         // Every byte value at every position parses or is refused, never panics.
         for i in 0..bytes.len() {

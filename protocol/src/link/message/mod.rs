@@ -54,8 +54,8 @@ pub use batch::{
 };
 pub use configure::{Configure, ModelParams, Rate, RegisterOverride, Source};
 pub use configure::{MAX_CONFIGURE_LEN, MAX_OVERRIDES};
-pub use fault::{kind_code as fault_kind_code, AddFault};
 pub use device::{AddDevice, DeviceBus, MAX_DEVICES, MAX_DEVICE_OVERRIDES};
+pub use fault::{kind_code as fault_kind_code, AddFault};
 pub use images::{
     max_images_per_batch, Image, ImageBatch, ImageItems, IMAGE_BATCH_HEADER_LEN, MAX_IMAGE_LEN,
 };
