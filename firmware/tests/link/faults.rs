@@ -334,10 +334,7 @@ fn sensor_faults_in_source_b_are_served_as_the_host_predicts_and_only_in_their_w
 /// sample's (index, latch time) as the Served reports give them (a batch's first entry at its
 /// time, the others at their nominal instants) and the reports' (first index, first time,
 /// entries).
-fn serve_timed(
-    faults: &[Fault],
-    configure: Configure,
-) -> (Vec<(u64, u64)>, Vec<(u64, u64, usize)>, Dev) {
+fn serve_timed(faults: &[Fault], configure: Configure) -> Timed {
     let mut dev = Dev::new();
     let mut host = Host::new();
     host.hello(&mut dev, 1);
@@ -363,8 +360,11 @@ fn serve_timed(
         }
         t += 10_000;
     }
-    (latches, reports, dev)
+    (latches, reports)
 }
+
+/// Each sample's (index, latch time), and the Served reports' (first index, time, entries).
+type Timed = (Vec<(u64, u64)>, Vec<(u64, u64, usize)>);
 
 fn nominal(k: u64) -> u64 {
     k * MS
@@ -379,7 +379,7 @@ fn late_and_clock_offset_move_the_latch_inside_their_windows_only() {
     };
     let clock = Fault::new(0, win(20, 30), offset);
     let cfg = Configure::new(ChipModel::Mpu9250, rate_1khz());
-    let (latches, reports, _) = serve_timed(&[late, clock], cfg);
+    let (latches, reports) = serve_timed(&[late, clock], cfg);
     assert_eq!(latches.len(), 40);
     for &(k, at) in &latches {
         let t = nominal(k);
@@ -410,7 +410,7 @@ fn jitter_draws_from_the_faults_own_stream_and_never_reorders() {
     let jitter = Fault::new(0, win(10, 20), FaultKind::DrdyJitter { max_ns: 2_500_000 });
     let nak = Fault::new(0, win(0, 40), FaultKind::Nak);
     let cfg = Configure::new(ChipModel::Mpu9250, rate_1khz());
-    let (latches, _, _) = serve_timed(&[nak, jitter], cfg);
+    let (latches, _) = serve_timed(&[nak, jitter], cfg);
     // The jitter fault is device 0's second: its stream is fault_rng(SEED, 1).
     let mut rng = fault_rng(SEED, 1);
     let mut floor = 0;
@@ -452,11 +452,7 @@ fn missing_data_ready_keeps_the_int_pin_where_it_was() {
         let just_after = k * MS + 10_000;
         poll(&mut dev, just_after);
         let pulse = dev.int_pin_at(0, just_after);
-        assert_eq!(
-            dev.chip().int_pin_at(just_after),
-            true,
-            "the chip pulses at {k}"
-        );
+        assert!(dev.chip().int_pin_at(just_after), "the chip pulses at {k}");
         assert_eq!(pulse, !(10..20).contains(&k), "sample {k}");
         let data = dev.last_served().unwrap();
         assert_eq!(
