@@ -100,6 +100,23 @@ impl FaultSchedule {
         self.faults.iter().filter(move |e| e.fault.device == device)
     }
 
+    /// `None` if some fault's window holds `t_ns`; else the first instant after `t_ns` a window
+    /// starts at ([`UNTIL_END`](margemu_model::fault::UNTIL_END) if none does): until then the
+    /// schedule does nothing.
+    pub fn quiet_until(&self, t_ns: u64) -> Option<u64> {
+        let mut next = u64::MAX;
+        for e in &self.faults {
+            let w = &e.fault.window;
+            if w.contains(t_ns) {
+                return None;
+            }
+            if w.start_ns > t_ns {
+                next = next.min(w.start_ns);
+            }
+        }
+        Some(next)
+    }
+
     /// Device `device`'s faults whose window holds `t_ns`.
     pub fn active(&self, device: u8, t_ns: u64) -> impl Iterator<Item = &ScheduledFault> {
         self.for_device(device)

@@ -112,6 +112,20 @@ impl FaultClock {
         latch
     }
 
+    /// The latch of a sample at `t_ns` that no fault window holds: `t_ns`, not before the last
+    /// latch.
+    pub fn idle_latch_ns(&self, t_ns: u64) -> u64 {
+        self.last_latch.map_or(t_ns, |l| l.max(t_ns))
+    }
+
+    /// Records a latch at `latch_ns` with no fault window open (no pulse left out), in place of
+    /// [`FaultClock::latch`].
+    pub fn idle_latch(&mut self, latch_ns: u64) {
+        self.last_latch = Some(latch_ns);
+        self.pending = None;
+        self.held_int = [None; MAX_DEVICES];
+    }
+
     /// Draws, for each device, whether sample `k`'s data-ready pulse is left out; call once per
     /// sample served, with each device's INT level just before the latch (`int_before`), before
     /// latching. Records the latch as the last one.

@@ -233,6 +233,13 @@ struct Core<const N: usize> {
     faults: FaultSchedule,
     fault_clock: FaultClock,
     chip_edges: ChipEdges,
+    /// Until this scene time no fault window opens (`FaultSchedule::quiet_until`): the
+    /// serving loop skips the schedule.
+    fault_quiet_until: u64,
+    /// Whether the last sample served was latched off its nominal instant, and the first of the
+    /// Served batch being built.
+    last_shifted: bool,
+    served_first_shifted: bool,
     counters: Counters,
     seq: SeqTracker,
     last_served: Option<Served>,
@@ -283,6 +290,9 @@ impl<const N: usize> Device<N> {
                 faults: FaultSchedule::new(),
                 fault_clock: FaultClock::new(),
                 chip_edges: ChipEdges::new(),
+                fault_quiet_until: 0,
+                last_shifted: false,
+                served_first_shifted: false,
                 counters: Counters::default(),
                 seq: SeqTracker::new(),
                 last_served: None,
@@ -576,6 +586,7 @@ impl<const N: usize> Core<N> {
         self.faults.clear();
         self.fault_clock = FaultClock::new();
         self.chip_edges = ChipEdges::new();
+        self.fault_quiet_until = 0;
     }
 
     fn add_fault(&mut self, a: &AddFault, seq: u16) {
@@ -717,9 +728,9 @@ impl<const N: usize> Core<N> {
                 self.telemetry_pending = true;
                 return;
             }
-            let latch = match self.faults.is_empty() {
-                true => t,
-                false => self.fault_clock.latch_ns(&self.faults, clock.next_k, t),
+            let latch = match self.fault_quiet(t) {
+                Some(latch) => latch,
+                None => self.fault_clock.latch_ns(&self.faults, clock.next_k, t),
             };
             if latch > now {
                 break;
@@ -730,6 +741,18 @@ impl<const N: usize> Core<N> {
         }
         self.clock = Some(clock);
         self.rig.advance(now);
+    }
+
+    /// The latch of a sample at nominal `t` while the schedule is quiet (no window holds it and
+    /// none opens by its latch: nothing to do but keep the latches in order); `None` when the
+    /// schedule must run.
+    #[inline]
+    fn fault_quiet(&self, t: u64) -> Option<u64> {
+        if self.faults.is_empty() {
+            return Some(t);
+        }
+        let latch = self.fault_clock.idle_latch_ns(t);
+        (latch < self.fault_quiet_until).then_some(latch)
     }
 
     /// Fires the chip faults' edges due by `latch` and records the latch with the fault clock
@@ -753,7 +776,13 @@ impl<const N: usize> Core<N> {
     /// timing fault moves it): the model steps at `t`, the chips latch at `latch`.
     fn serve(&mut self, k: u64, t: u64, latch: u64) {
         if !self.faults.is_empty() {
-            self.fault_edges(t, latch);
+            match self.fault_quiet(t) {
+                Some(_) => self.fault_clock.idle_latch(latch),
+                None => {
+                    self.fault_edges(t, latch);
+                    self.fault_quiet_until = self.faults.quiet_until(t).unwrap_or(0);
+                }
+            }
         }
         let (image, underrun) = match self.model.as_mut() {
             None => match self.ring.take(k) {
@@ -782,6 +811,7 @@ impl<const N: usize> Core<N> {
         if underrun {
             c.underruns = c.underruns.wrapping_add(1);
         }
+        self.last_shifted = latch != t;
         self.last_served = Some(Served {
             index: k,
             time_ns: latch,
@@ -794,17 +824,17 @@ impl<const N: usize> Core<N> {
     /// full or the new index does not follow it).
     fn log_served(&mut self, tx: &mut impl FnMut(&[u8])) {
         let Some(s) = self.last_served else { return };
-        let (first, first_time) = self.served_first;
+        let (first, _) = self.served_first;
         let follows = first.checked_add(self.served_len as u64) == Some(s.index);
         // An entry latched off its nominal instant (a timing fault) is a batch of its own, so
         // the batch's time is its own (§5.16).
-        let nominal = |k| self.session.map(|se| se.rate.sample_time_ns(k));
-        let on_time = nominal(s.index) == Some(s.time_ns) && nominal(first) == Some(first_time);
+        let on_time = !self.last_shifted && !self.served_first_shifted;
         if self.served_len == SERVED_CAPACITY || (self.served_len > 0 && !(follows && on_time)) {
             self.flush_served(tx);
         }
         if self.served_len == 0 {
             self.served_first = (s.index, s.time_ns);
+            self.served_first_shifted = self.last_shifted;
         }
         if let Some(slot) = self.served.get_mut(self.served_len) {
             *slot = ServedSample {

@@ -211,7 +211,10 @@ pub struct DeviceModel {
     marg: Marg,
     front: Option<ModelFront>,
     rate_hz: f64,
+    /// The device's faults (every class, so each keeps its index).
     faults: Option<SensorFaults>,
+    /// Whether one of them is a sensor fault (else [`model_image`] skips them).
+    sensor_faults: bool,
 }
 
 impl DeviceModel {
@@ -231,6 +234,7 @@ impl DeviceModel {
             front,
             rate_hz: rate.as_hz_f64(),
             faults: None,
+            sensor_faults: false,
         })
     }
 
@@ -239,19 +243,23 @@ impl DeviceModel {
     /// push fixes it). Sensor faults act from then on in [`model_image`].
     pub fn push_fault(&mut self, fault: &Fault, seed: u64) -> Result<(), ScheduleFull> {
         let rate_hz = self.rate_hz;
-        self.faults
-            .get_or_insert_with(|| SensorFaults::new(seed, rate_hz))
-            .push(fault)
+        let faults = self
+            .faults
+            .get_or_insert_with(|| SensorFaults::new(seed, rate_hz));
+        faults.push(fault)?;
+        self.sensor_faults = !faults.is_empty();
+        Ok(())
     }
 
     /// Takes the device's faults as a whole (built by the caller with the output rate).
     pub fn set_faults(&mut self, faults: SensorFaults) {
+        self.sensor_faults = !faults.is_empty();
         self.faults = Some(faults);
     }
 
     /// The faults, to carry over into a rebuilt model (before Start).
-    fn take_faults(&mut self) -> Option<SensorFaults> {
-        self.faults.take()
+    fn take_faults(&mut self) -> (Option<SensorFaults>, bool) {
+        (self.faults.take(), self.sensor_faults)
     }
 
     /// One output sample at `t_ns` from `truth`.
@@ -309,7 +317,7 @@ impl Model {
         let p = &self.params;
         match DeviceModel::new(&p.marg, self.rate, p.seed, chip, &chain) {
             Ok(mut model) => {
-                model.faults = self.model.take_faults();
+                (model.faults, model.sensor_faults) = self.model.take_faults();
                 self.model = model;
                 self.chain = chain;
                 true
@@ -385,7 +393,7 @@ pub fn model_image(
 ) -> Image {
     let mut s = model.sample(t_ns, truth);
     let dropout = match model.faults.as_mut() {
-        Some(f) if !f.is_empty() => f.apply(t_ns, &mut s),
+        Some(f) if model.sensor_faults => f.apply(t_ns, &mut s),
         _ => 0,
     };
     let sample = PhysicalSample {
