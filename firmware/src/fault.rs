@@ -13,6 +13,8 @@
 //! s.push(Fault::new(1, Window::new(30, 40), FaultKind::Nak), 99).unwrap();
 //! assert_eq!(s.active(1, 35).map(|e| e.index).collect::<Vec<_>>(), [1]);
 //! assert_eq!(s.active(0, 35).count(), 0);
+//! // Nothing happens between 20 and 30, nor after 40.
+//! assert_eq!((s.quiet_until(25), s.quiet_until(35), s.quiet_until(45)), (Some(30), None, Some(u64::MAX)));
 //! ```
 
 use margemu_model::fault::{fault_rng, overlaps_exclusively, Fault, ScheduleFull, MAX_FAULTS};
