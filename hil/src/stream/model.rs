@@ -28,6 +28,11 @@
 //! ([`ModelPrediction::vibration`]); host and device build it with the one constructor
 //! `setup::model_chain`, so the images stay bit-identical.
 //!
+//! **Faults.** Device 0's faults of the scene's schedule go into the model ([`push_faults`],
+//! as the device does on AddFault, with the scene's seed), so its sensor faults act in
+//! `setup::model_image` on both sides alike; the session sends the schedule
+//! ([`fault_messages`](super::fault_messages)).
+//!
 //! Scenes the device cannot run are refused before anything is sent ([`StreamError::Model`]):
 //! a magnetic perturbation or random vibration (their FFT buffers do not fit a no-alloc
 //! device), more rpm points, tone sources or shocks than the device holds, a chain too slow for
