@@ -158,3 +158,17 @@ fn source_b_serves_the_sensor_faults_inside_their_windows_only() {
     );
     assert_eq!(faulty[800..], clean[800..]);
 }
+
+#[test]
+fn a_schedule_the_device_would_refuse_is_refused_before_anything_is_sent() {
+    let mut s = scene(0.1, 1000.0);
+    s.faults = vec![Fault::new(1, win(0, 10), FaultKind::Late { delay_ns: 10 })];
+    let dir = scratch("fault-schedule-refused");
+    let err = Session::new(&s, config(), &dir).err().expect("refused");
+    let text = err.to_string();
+    assert!(text.contains("fault 1 (late on device 1)"), "{text}");
+    assert!(!dir.exists(), "nothing written");
+    s.faults = vec![Fault::new(0, win(0, 10), FaultKind::Nak); 17];
+    let err = Session::new(&s, config(), &dir).err().expect("refused");
+    assert!(err.to_string().contains("17 faults"), "{err}");
+}

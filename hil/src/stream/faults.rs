@@ -22,9 +22,36 @@
 //! assert_eq!((msgs.len(), msgs[0].seed), (1, 5));
 //! ```
 
+use margemu_firmware::link::faults::shifts_latch;
+use margemu_model::fault::MAX_FAULTS;
 use margemu_protocol::link::AddFault;
 use margemu_sim::marg::device_seed;
 use margemu_sim::scene::Scene;
+
+/// Why the device would refuse `scene`'s schedule, before anything is sent: more than
+/// [`MAX_FAULTS`] faults, or a timing fault that moves the latch (clock_offset, late,
+/// drdy_jitter) on a device other than the first (a rig's devices share the device's one
+/// serving clock). The scene check refuses the rest (overlaps, unknown devices).
+pub fn fault_refusal(scene: &Scene) -> Option<String> {
+    if scene.faults.len() > MAX_FAULTS {
+        return Some(format!(
+            "the scene has {} faults: the device holds at most {MAX_FAULTS}",
+            scene.faults.len()
+        ));
+    }
+    let (i, f) = scene
+        .faults
+        .iter()
+        .enumerate()
+        .find(|(_, f)| f.device != 0 && shifts_latch(&f.kind))?;
+    Some(format!(
+        "fault {} ({} on device {}): a rig's devices share the device's one serving clock, \
+         so only the first device's samples can be moved; put it on device 0",
+        i + 1,
+        f.kind.name(),
+        f.device
+    ))
+}
 
 /// The AddFault messages of `scene`'s schedule, in order (see the module docs).
 pub fn fault_messages(scene: &Scene) -> Vec<AddFault> {

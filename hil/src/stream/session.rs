@@ -124,6 +124,9 @@ impl Session {
             .images
             .unwrap_or_else(|| ImageSettings::for_scene(scene));
         let rate = rate_of(scene)?;
+        if let Some(reason) = super::faults::fault_refusal(scene) {
+            return Err(StreamError::Unsupported { reason });
+        }
         let (mut prediction, items, hold) = match config.source {
             SourceMode::Images => (
                 Prediction::images(predict_images(scene, &settings)),
