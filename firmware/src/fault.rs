@@ -13,6 +13,8 @@
 //! s.push(Fault::new(1, Window::new(30, 40), FaultKind::Nak), 99).unwrap();
 //! assert_eq!(s.active(1, 35).map(|e| e.index).collect::<Vec<_>>(), [1]);
 //! assert_eq!(s.active(0, 35).count(), 0);
+//! // Nothing happens between 20 and 30, nor after 40.
+//! assert_eq!((s.quiet_until(25), s.quiet_until(35), s.quiet_until(45)), (Some(30), None, Some(u64::MAX)));
 //! ```
 
 use margemu_model::fault::{fault_rng, overlaps_exclusively, Fault, ScheduleFull, MAX_FAULTS};
@@ -98,6 +100,23 @@ impl FaultSchedule {
     /// Device `device`'s faults, in order.
     pub fn for_device(&self, device: u8) -> impl Iterator<Item = &ScheduledFault> {
         self.faults.iter().filter(move |e| e.fault.device == device)
+    }
+
+    /// `None` if some fault's window holds `t_ns`; else the first instant after `t_ns` a window
+    /// starts at ([`UNTIL_END`](margemu_model::fault::UNTIL_END) if none does): until then the
+    /// schedule does nothing.
+    pub fn quiet_until(&self, t_ns: u64) -> Option<u64> {
+        let mut next = u64::MAX;
+        for e in &self.faults {
+            let w = &e.fault.window;
+            if w.contains(t_ns) {
+                return None;
+            }
+            if w.start_ns > t_ns {
+                next = next.min(w.start_ns);
+            }
+        }
+        Some(next)
     }
 
     /// Device `device`'s faults whose window holds `t_ns`.

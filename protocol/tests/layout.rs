@@ -192,7 +192,7 @@ fn register_writes_and_error() {
     assert_eq!(b, [8, 0x02, 0x01, 0x0D, 0x0C, 0x0B, 0x0A]);
     parses_back(Kind::Error, &b, &m);
     assert_eq!(
-        Message::parse(0x86, &[11, 0, 0, 0, 0, 0, 0]),
+        Message::parse(0x86, &[12, 0, 0, 0, 0, 0, 0]),
         Err(Error::InvalidValue)
     );
 }

@@ -197,6 +197,7 @@ fn model(elf: &Path, rate: u32, o: &Options) -> Row {
     let script = Script {
         configure: stream.configure(50_000_000),
         vibration: stream.vibration.clone(),
+        faults: stream.faults.clone(),
         samples: Samples::Kinematics(&stream.kinematics),
         sample_rate: stream.params.truth_rate,
         outputs: predicted.len() as u64,

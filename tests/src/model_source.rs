@@ -11,9 +11,11 @@
 
 use margemu::scene::chip::ChipSetup;
 use margemu::scene::Scene;
-use margemu::stream::{predict_model, rate_of, ImageSettings, StreamError};
+use margemu::stream::{fault_messages, predict_model, rate_of, ImageSettings, StreamError};
 use margemu_model::sensor::Truth;
-use margemu_protocol::link::{AddVibration, Configure, Image, ModelParams, Rate, Source, CRC32C};
+use margemu_protocol::link::{
+    AddFault, AddVibration, Configure, Image, ModelParams, Rate, Source, CRC32C,
+};
 
 /// One scene prepared for source mode (b).
 #[derive(Clone, Debug)]
@@ -30,6 +32,9 @@ pub struct ModelStream {
     pub chip: ChipSetup,
     /// The AddVibration messages that follow Configure (the chain the device runs).
     pub vibration: Vec<AddVibration>,
+    /// The AddFault messages that follow them (the scene's fault schedule; device 0's sensor
+    /// faults are in `images`).
+    pub faults: Vec<AddFault>,
 }
 
 /// Why a scene cannot be streamed in source mode (b).
@@ -74,6 +79,7 @@ impl ModelStream {
             out_rate,
             params: prediction.params,
             vibration: prediction.vibration,
+            faults: fault_messages(scene),
             kinematics,
             images,
             chip: scene.chip,

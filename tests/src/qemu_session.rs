@@ -23,7 +23,7 @@ use serialport::SerialPort;
 use crate::drive::{self, Report, Samples, Script};
 use crate::model_source::ModelStream;
 use crate::qemu::{self, Qemu};
-use crate::served::{Check, ServedTap};
+use crate::served::{Check, ServedLog, ServedTap};
 
 /// The board ELF, built (or found up to date), and how long that took.
 pub fn build_board() -> (PathBuf, Duration) {
@@ -64,6 +64,8 @@ pub struct ImageRun {
     pub summary: Summary,
     /// The Served reports against the prediction (all exact).
     pub check: Check,
+    /// Every Served entry the device sent.
+    pub served: ServedLog,
     /// Boot and stream.
     pub streamed: Duration,
 }
@@ -122,6 +124,7 @@ pub fn run_images(
     ImageRun {
         summary,
         check,
+        served,
         streamed,
     }
 }
@@ -132,6 +135,7 @@ pub fn model_script<'a>(stream: &'a ModelStream, configure: Configure) -> Script
     Script {
         configure,
         vibration: stream.vibration.clone(),
+        faults: stream.faults.clone(),
         samples: Samples::Kinematics(&stream.kinematics),
         sample_rate: stream.params.truth_rate,
         outputs: stream.images.len() as u64,

@@ -25,6 +25,9 @@ use crate::qemu::LinkDecoder;
 #[derive(Clone, Debug, Default)]
 pub struct ServedLog {
     entries: BTreeMap<u64, ServedSample>,
+    /// Each batch's first index and the scene time it carries (a sample a timing fault moved is
+    /// a batch of its own, at its latch time).
+    pub batch_times: BTreeMap<u64, u64>,
     /// Entries for an index already reported (the device reports each instant once).
     pub duplicates: u64,
 }
@@ -32,6 +35,8 @@ pub struct ServedLog {
 impl ServedLog {
     /// Adds the entries of one Served frame.
     pub fn record(&mut self, batch: &ServedBatch<'_>) {
+        self.batch_times
+            .insert(batch.first_index, batch.first_time_ns);
         for (index, s) in (batch.first_index..).zip(batch.samples.iter()) {
             if self.entries.insert(index, s).is_some() {
                 self.duplicates += 1;
@@ -162,4 +167,31 @@ fn ranges(v: &[u64]) -> String {
         .collect();
     let more = if out.len() > 8 { ", …" } else { "" };
     format!("[{}{more}]", shown.join(", "))
+}
+
+/// The scene time each output sample `0 .. n` at `rate` is latched at under `faults`, by the
+/// firmware's own serving clock (`margemu_firmware::link::faults::FaultClock`), as the device
+/// runs it: what a Served batch starting at that sample carries.
+pub fn predicted_latches(
+    faults: &[margemu_protocol::link::AddFault],
+    rate: margemu_protocol::link::Rate,
+    n: u64,
+) -> Vec<u64> {
+    use margemu_firmware::fault::FaultSchedule;
+    use margemu_firmware::link::faults::FaultClock;
+    let mut schedule = FaultSchedule::new();
+    for f in faults {
+        schedule
+            .push(f.fault, f.seed)
+            .expect("a schedule the device takes");
+    }
+    let mut clock = FaultClock::new();
+    (0..n)
+        .map(|k| {
+            let t = rate.sample_time_ns(k);
+            let latch = clock.latch_ns(&schedule, k, t);
+            clock.latch(&schedule, latch, t, |_| None);
+            latch
+        })
+        .collect()
 }

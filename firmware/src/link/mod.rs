@@ -19,8 +19,23 @@
 //! of the other source (5; detail 2 [`VIBRATION_IN_IMAGES`]: an AddVibration in source (a)), a
 //! model the shared `Marg` refuses, a Configure or AddVibration while running, or an
 //! AddVibration the model cannot hold (6; detail [`VIBRATION_REFUSED`]),
-//! Start or samples before Configure (7), a second Start while running (9). Samples beyond the
+//! Start or samples before Configure (7), a second Start while running (9), an AddFault the
+//! schedule cannot take (11; detail [`FAULT_SCHEDULE_FULL`], [`FAULT_OVERLAPS`] an exclusive
+//! overlap, [`FAULT_NO_DEVICE`], [`FAULT_UNSUPPORTED`] a chip fault whose chip hook returns
+//! `false` or a latch-moving timing fault on a device other than 0; an AddFault while running
+//! is 6, before Configure 7). Samples beyond the
 //! credit limit are answered with Error 8 (detail: the first dropped index, truncated).
+//!
+//! **Faults** (`docs/spec/link.md` §5.16). AddFault messages fill a [`FaultSchedule`]
+//! ([`Device::faults`], for the bus targets), cleared by Configure and Hello. At each output
+//! instant the device fires the chip faults' edges due ([`faults::ChipEdges`]: the chips'
+//! `fault_reset`, `fault_identity`, `fault_fifo_overflow` hooks, counted in
+//! [`Counters::chip_fault_edges`]), latches at the instant the timing faults give
+//! ([`faults::FaultClock`]; the model still steps at the nominal instant) and, for a
+//! missing_drdy draw, holds the device's INT level ([`Device::int_pin_at`], what boards drive).
+//! In source (b) device 0's sensor faults act in the model ([`setup::model_image`]).
+//! A sample latched off its nominal instant is reported in a Served batch of its own, with its
+//! latch time. Without faults nothing of this runs.
 //!
 //! **Register writes** of the device under test are drained from the chip's write log at every
 //! poll and stamped with the scene time of that poll (the log itself has no time stamps), so
@@ -35,7 +50,8 @@
 //!
 //! **Time base.** Start { t0, end_index } received at local time `s` sets the scene clock to
 //! `t0 + (now_ns − s)`. Output sample `k` is served when the scene clock reaches
-//! `rate.sample_time_ns(k) = floor(k·den·10⁹/num)`, the first being the smallest `k` with that
+//! `rate.sample_time_ns(k) = floor(k·den·10⁹/num)` (moved by a timing fault, see **Faults**),
+//! the first being the smallest `k` with that
 //! instant `≥ t0`; the chip is latched at that scene time, so its registers, INT pulses and
 //! AK8963 schedule run on scene time. A late poll serves the missed instants in order (at most
 //! [`MAX_CATCH_UP`] per call). At the instant of sample `end_index` the device stops by itself
@@ -73,6 +89,7 @@
 //! assert_eq!(frames, 2); // Reset (after boot), HelloAck
 //! ```
 
+pub mod faults;
 pub mod rig;
 mod ring;
 pub mod setup;
@@ -82,14 +99,17 @@ pub use ring::{Insert, SampleRing};
 use margemu_model::sensor::Truth;
 use margemu_protocol::link::{max_images_per_batch, ServedBatch, ServedSample, CRC32C};
 use margemu_protocol::link::{
-    Accumulator, AddDevice, AddVibration, Bus, Buses, Capabilities, Configure, Credit, DeviceState,
-    Encoder, ErrorCode, ErrorReport, FeedResult, FirmwareVersion, Frame, Hello, HelloAck, Image,
-    Kind, Message, Modes, Rate, RegisterWrite, RegisterWriteBatch, Reset, ResetCause, RxStats,
-    SeqTracker, Source, Start, Telemetry, DEVICE_ID_LEN, MAX_WIRE_LEN,
+    Accumulator, AddDevice, AddFault, AddVibration, Bus, Buses, Capabilities, Configure, Credit,
+    DeviceState, Encoder, ErrorCode, ErrorReport, FeedResult, FirmwareVersion, Frame, Hello,
+    HelloAck, Image, Kind, Message, Modes, Rate, RegisterWrite, RegisterWriteBatch, Reset,
+    ResetCause, RxStats, SeqTracker, Source, Start, Telemetry, DEVICE_ID_LEN, MAX_WIRE_LEN,
 };
 use margemu_protocol::PROTOCOL_VERSION;
 
-use crate::chip::{self, EmulatedChip};
+use crate::chip::{self, Chip, EmulatedChip};
+use crate::fault::{FaultSchedule, ScheduleError};
+use faults::{ChipEdge, ChipEdges, FaultClock};
+use margemu_model::fault::{FaultClass, FaultKind};
 use rig::Rig;
 use setup::Model;
 
@@ -99,6 +119,18 @@ pub const VIBRATION_IN_IMAGES: u32 = 2;
 /// or a chain the model refuses with it (an invalid source, filter settings the chip does not
 /// have at the rate).
 pub const VIBRATION_REFUSED: u32 = 7;
+
+/// Error 11's details (`docs/spec/link.md` §5.16): the schedule holds
+/// [`MAX_FAULTS`](margemu_model::fault::MAX_FAULTS) faults already.
+pub const FAULT_SCHEDULE_FULL: u32 = 1;
+/// Error 11: the fault overlaps an earlier one of its exclusive group on its device.
+pub const FAULT_OVERLAPS: u32 = 2;
+/// Error 11: the rig has no such device.
+pub const FAULT_NO_DEVICE: u32 = 3;
+/// Error 11: the device's chip cannot apply this chip fault (its hook returned `false`), or a
+/// timing fault that moves the latch names a device other than 0 (a rig's devices share one
+/// serving clock).
+pub const FAULT_UNSUPPORTED: u32 = 4;
 
 /// The shortest image of any model (the standalone magnetometers).
 const SMALLEST_IMAGE_LEN: usize = margemu_protocol::regmap::mag_image::IMAGE_LEN;
@@ -137,6 +169,8 @@ pub struct Counters {
     pub underruns: u32,
     /// Samples dropped at or beyond the credit limit.
     pub overruns: u32,
+    /// Chip-fault hooks the chips applied at window edges (a start, an end).
+    pub chip_fault_edges: u32,
     /// Receive-side counters (damaged frames, lost frames, rejected messages).
     pub rx: RxStats,
 }
@@ -195,6 +229,17 @@ struct Core<const N: usize> {
     model: Option<Model>,
     clock: Option<Clock>,
     ring: SampleRing<Slot, N>,
+    /// The fault schedule (AddFault), its serving clock and its chip-fault edges.
+    faults: FaultSchedule,
+    fault_clock: FaultClock,
+    chip_edges: ChipEdges,
+    /// Until this scene time no fault window opens (`FaultSchedule::quiet_until`): the
+    /// serving loop skips the schedule.
+    fault_quiet_until: u64,
+    /// Whether the last sample served was latched off its nominal instant, and the first of the
+    /// Served batch being built.
+    last_shifted: bool,
+    served_first_shifted: bool,
     counters: Counters,
     seq: SeqTracker,
     last_served: Option<Served>,
@@ -242,6 +287,12 @@ impl<const N: usize> Device<N> {
                 model: None,
                 clock: None,
                 ring: SampleRing::new(),
+                faults: FaultSchedule::new(),
+                fault_clock: FaultClock::new(),
+                chip_edges: ChipEdges::new(),
+                fault_quiet_until: 0,
+                last_shifted: false,
+                served_first_shifted: false,
                 counters: Counters::default(),
                 seq: SeqTracker::new(),
                 last_served: None,
@@ -302,6 +353,23 @@ impl<const N: usize> Device<N> {
     /// [`Rig::i2c_target`]).
     pub fn rig_mut(&mut self) -> &mut Rig {
         &mut self.core.rig
+    }
+
+    /// The fault schedule the host sent (AddFault), for the bus targets.
+    pub fn faults(&self) -> &FaultSchedule {
+        &self.core.faults
+    }
+
+    /// The level of device `device`'s (first) INT pin at local time `now_ns`: the chip's own
+    /// ([`Chip::int_pin_at`] at the scene time), except while a missing_drdy fault leaves
+    /// the last data-ready pulse out (the level it had before that latch). What a board drives
+    /// and a host's virtual flight controller reads; `false` for a device the rig lacks.
+    pub fn int_pin_at(&self, device: usize, now_ns: u64) -> bool {
+        if let Some(level) = self.core.fault_clock.int_pin(device) {
+            return level;
+        }
+        let t = self.core.scene_time(now_ns);
+        self.core.rig.chip(device).is_some_and(|c| c.int_pin_at(t))
     }
 
     /// The counters.
@@ -390,6 +458,7 @@ impl<const N: usize> Core<N> {
             Message::Stop => self.stop(now_ns),
             Message::AddDevice(a) => self.add_device(&a, seq),
             Message::AddVibration(v) => self.add_vibration(&v, seq),
+            Message::AddFault(f) => self.add_fault(&f, seq),
             Message::Images(b) => {
                 let configured = self.session.map(|s| usize::from(s.image_len));
                 if !b.images.is_empty() && configured.is_some_and(|n| n != b.images.image_len()) {
@@ -421,6 +490,7 @@ impl<const N: usize> Core<N> {
         self.model = None;
         self.clock = None;
         self.ring.reset(0);
+        self.clear_faults();
         let rx = RxStats {
             frames: 1,
             ..RxStats::default()
@@ -473,6 +543,7 @@ impl<const N: usize> Core<N> {
         self.model = model;
         self.clock = None;
         self.ring.reset(0);
+        self.clear_faults();
         self.last_image = None;
         self.state = DeviceState::Configured;
         self.credit_pending = true;
@@ -508,6 +579,42 @@ impl<const N: usize> Core<N> {
         };
         if !model.add_vibration(v, self.rig.primary()) {
             self.refuse(ErrorCode::InvalidConfig, seq, VIBRATION_REFUSED);
+        }
+    }
+
+    fn clear_faults(&mut self) {
+        self.faults.clear();
+        self.fault_clock = FaultClock::new();
+        self.chip_edges = ChipEdges::new();
+        self.fault_quiet_until = 0;
+    }
+
+    fn add_fault(&mut self, a: &AddFault, seq: u16) {
+        if self.session.is_none() {
+            return self.refuse(ErrorCode::NotConfigured, seq, 0);
+        }
+        if self.state == DeviceState::Running {
+            return self.refuse(ErrorCode::InvalidConfig, seq, DeviceState::Running as u32);
+        }
+        let f = &a.fault;
+        let Some(chip) = self.rig.chip(usize::from(f.device)) else {
+            return self.refuse(ErrorCode::FaultRefused, seq, FAULT_NO_DEVICE);
+        };
+        let timing_elsewhere = f.device != 0 && faults::shifts_latch(&f.kind);
+        if timing_elsewhere || !chip_fault_supported(chip, &f.kind) {
+            return self.refuse(ErrorCode::FaultRefused, seq, FAULT_UNSUPPORTED);
+        }
+        if let Err(e) = self.faults.push(*f, a.seed) {
+            let detail = match e {
+                ScheduleError::Full => FAULT_SCHEDULE_FULL,
+                ScheduleError::Overlaps => FAULT_OVERLAPS,
+            };
+            return self.refuse(ErrorCode::FaultRefused, seq, detail);
+        }
+        // Device 0's model takes every fault of device 0 (each keeps its index among them);
+        // it holds as many as the schedule.
+        if let Some(model) = self.model.as_mut().filter(|_| f.device == 0) {
+            let _ = model.push_fault(f, a.seed);
         }
     }
 
@@ -604,20 +711,31 @@ impl<const N: usize> Core<N> {
         self.scene_now_ns = now;
         for _ in 0..MAX_CATCH_UP {
             let t = session.rate.sample_time_ns(clock.next_k);
-            if t > now || clock.next_k == u64::MAX {
+            if clock.next_k == u64::MAX {
                 break;
             }
             if clock.next_k >= clock.end_k || (self.draining && self.ring.level() == 0) {
+                if t > now {
+                    break;
+                }
                 // The scene's end, or nothing left after a Stop: stop at this instant, serving
                 // nothing for it.
                 self.clock = Some(clock);
                 self.draining = false;
                 self.state = DeviceState::Stopped;
-                self.scene_now_ns = t;
+                // (Not before the last latch, which a timing fault may have moved past `t`.)
+                self.scene_now_ns = self.last_served.map_or(t, |s| s.time_ns.max(t));
                 self.telemetry_pending = true;
                 return;
             }
-            self.serve(clock.next_k, t);
+            let latch = match self.fault_quiet(t) {
+                Some(latch) => latch,
+                None => self.fault_clock.latch_ns(&self.faults, clock.next_k, t),
+            };
+            if latch > now {
+                break;
+            }
+            self.serve(clock.next_k, t, latch);
             self.log_served(tx);
             clock.next_k += 1;
         }
@@ -625,7 +743,47 @@ impl<const N: usize> Core<N> {
         self.rig.advance(now);
     }
 
-    fn serve(&mut self, k: u64, t: u64) {
+    /// The latch of a sample at nominal `t` while the schedule is quiet (no window holds it and
+    /// none opens by its latch: nothing to do but keep the latches in order); `None` when the
+    /// schedule must run.
+    #[inline]
+    fn fault_quiet(&self, t: u64) -> Option<u64> {
+        if self.faults.is_empty() {
+            return Some(t);
+        }
+        let latch = self.fault_clock.idle_latch_ns(t);
+        (latch < self.fault_quiet_until).then_some(latch)
+    }
+
+    /// Fires the chip faults' edges due by `latch` and records the latch with the fault clock
+    /// (the data-ready pulses it leaves out), before sample `k` (nominal `t`) is latched.
+    fn fault_edges(&mut self, t: u64, latch: u64) {
+        let (rig, counters) = (&mut self.rig, &mut self.counters);
+        self.chip_edges.fire_due(&self.faults, latch, |edge| {
+            if let Some(chip) = rig.chip_mut(usize::from(edge.device)) {
+                if apply_chip_edge(chip, &edge) {
+                    counters.chip_fault_edges = counters.chip_fault_edges.wrapping_add(1);
+                }
+            }
+        });
+        let rig = &self.rig;
+        self.fault_clock.latch(&self.faults, latch, t, |d| {
+            rig.chip(d).map(|c| c.int_pin_at(latch))
+        });
+    }
+
+    /// Serves output sample `k` of nominal instant `t`, latched at `latch` (`t` unless a
+    /// timing fault moves it): the model steps at `t`, the chips latch at `latch`.
+    fn serve(&mut self, k: u64, t: u64, latch: u64) {
+        if !self.faults.is_empty() {
+            match self.fault_quiet(t) {
+                Some(_) => self.fault_clock.idle_latch(latch),
+                None => {
+                    self.fault_edges(t, latch);
+                    self.fault_quiet_until = self.faults.quiet_until(t).unwrap_or(0);
+                }
+            }
+        }
         let (image, underrun) = match self.model.as_mut() {
             None => match self.ring.take(k) {
                 Some(Slot::Image(image)) => (Some(image), false),
@@ -645,7 +803,7 @@ impl<const N: usize> Core<N> {
             }
         };
         if let Some(image) = &image {
-            self.rig.latch_image_at(image, t);
+            self.rig.latch_image_at(image, latch);
         }
         self.last_image = image.or(self.last_image);
         let c = &mut self.counters;
@@ -653,9 +811,10 @@ impl<const N: usize> Core<N> {
         if underrun {
             c.underruns = c.underruns.wrapping_add(1);
         }
+        self.last_shifted = latch != t;
         self.last_served = Some(Served {
             index: k,
-            time_ns: t,
+            time_ns: latch,
             image,
             underrun,
         });
@@ -667,11 +826,15 @@ impl<const N: usize> Core<N> {
         let Some(s) = self.last_served else { return };
         let (first, _) = self.served_first;
         let follows = first.checked_add(self.served_len as u64) == Some(s.index);
-        if self.served_len == SERVED_CAPACITY || (self.served_len > 0 && !follows) {
+        // An entry latched off its nominal instant (a timing fault) is a batch of its own, so
+        // the batch's time is its own (§5.16).
+        let on_time = !self.last_shifted && !self.served_first_shifted;
+        if self.served_len == SERVED_CAPACITY || (self.served_len > 0 && !(follows && on_time)) {
             self.flush_served(tx);
         }
         if self.served_len == 0 {
             self.served_first = (s.index, s.time_ns);
+            self.served_first_shifted = self.last_shifted;
         }
         if let Some(slot) = self.served.get_mut(self.served_len) {
             *slot = ServedSample {
@@ -819,5 +982,35 @@ fn wire_write(w: &chip::RegisterWrite, chip_select: u8, time_ns: u64) -> Registe
         address,
         register: w.register,
         value: w.value,
+    }
+}
+
+/// Whether `chip` can apply `kind`: `true` for every kind but the chip faults, for which the
+/// chip's hook is tried on a copy (a hook returning `false` is not implemented for this chip).
+fn chip_fault_supported(chip: &EmulatedChip, kind: &FaultKind) -> bool {
+    if kind.class() != FaultClass::Chip {
+        return true;
+    }
+    let mut probe = chip.clone();
+    apply_chip_edge(
+        &mut probe,
+        &ChipEdge {
+            device: 0,
+            kind: *kind,
+            begins: true,
+        },
+    )
+}
+
+/// Calls the chip's hook for a chip-fault edge; whether the chip applied it (a reset's end
+/// calls nothing: `false`).
+fn apply_chip_edge(chip: &mut EmulatedChip, edge: &ChipEdge) -> bool {
+    match (edge.kind, edge.begins) {
+        (FaultKind::Reset, true) => chip.fault_reset(),
+        (FaultKind::WrongIdentity { value }, begins) => {
+            chip.fault_identity(begins.then_some(value))
+        }
+        (FaultKind::FifoOverflow, on) => chip.fault_fifo_overflow(on),
+        _ => false,
     }
 }

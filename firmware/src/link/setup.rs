@@ -4,6 +4,7 @@
 #[cfg(feature = "model-vibration")]
 use margemu_model::chain::Front;
 use margemu_model::chain::{Clipper, DeviceChain};
+use margemu_model::fault::{Fault, ScheduleFull, SensorFaults};
 use margemu_model::perturbation::Complex;
 use margemu_model::sensor::{Marg, Truth};
 use margemu_model::vibration::{Shock, ToneSource, MAX_SHOCKS, MAX_TONE_SOURCES};
@@ -201,9 +202,19 @@ fn vibration_chain(
 /// The sensor model of source mode (b) at the output rate: the chain of [`model_chain`]
 /// (clipping at the chip's full scale, counted; the vibration and path of a [`ChainSetup`])
 /// and the error terms. The host predicts with the same ([`DeviceModel::new`] on both sides).
+///
+/// **Sensor faults.** A model may carry its device's [`SensorFaults`] ([`DeviceModel::push_fault`]
+/// or [`DeviceModel::set_faults`]): [`model_image`] applies them to each output sample before the
+/// conversion and writes the chip's invalid value for a dropout
+/// ([`ChipSettings::mark_invalid`]), on the device and in the host's prediction alike.
 pub struct DeviceModel {
     marg: Marg,
     front: Option<ModelFront>,
+    rate_hz: f64,
+    /// The device's faults (every class, so each keeps its index).
+    faults: Option<SensorFaults>,
+    /// Whether one of them is a sensor fault (else [`model_image`] skips them).
+    sensor_faults: bool,
 }
 
 impl DeviceModel {
@@ -218,7 +229,37 @@ impl DeviceModel {
     ) -> Result<Self, margemu_model::Error> {
         let marg = Marg::new(cfg, rate.as_hz_f64(), seed)?;
         let front = model_chain(&chip.settings(), rate, seed, setup).transpose()?;
-        Ok(Self { marg, front })
+        Ok(Self {
+            marg,
+            front,
+            rate_hz: rate.as_hz_f64(),
+            faults: None,
+            sensor_faults: false,
+        })
+    }
+
+    /// Appends the next fault of the device's schedule (every class: each keeps its index, so
+    /// its random stream is the host's); the device's seed `seed` keys the streams (the first
+    /// push fixes it). Sensor faults act from then on in [`model_image`].
+    pub fn push_fault(&mut self, fault: &Fault, seed: u64) -> Result<(), ScheduleFull> {
+        let rate_hz = self.rate_hz;
+        let faults = self
+            .faults
+            .get_or_insert_with(|| SensorFaults::new(seed, rate_hz));
+        faults.push(fault)?;
+        self.sensor_faults = !faults.is_empty();
+        Ok(())
+    }
+
+    /// Takes the device's faults as a whole (built by the caller with the output rate).
+    pub fn set_faults(&mut self, faults: SensorFaults) {
+        self.sensor_faults = !faults.is_empty();
+        self.faults = Some(faults);
+    }
+
+    /// The faults, to carry over into a rebuilt model (before Start).
+    fn take_faults(&mut self) -> (Option<SensorFaults>, bool) {
+        (self.faults.take(), self.sensor_faults)
     }
 
     /// One output sample at `t_ns` from `truth`.
@@ -275,13 +316,19 @@ impl Model {
         }
         let p = &self.params;
         match DeviceModel::new(&p.marg, self.rate, p.seed, chip, &chain) {
-            Ok(model) => {
+            Ok(mut model) => {
+                (model.faults, model.sensor_faults) = self.model.take_faults();
                 self.model = model;
                 self.chain = chain;
                 true
             }
             Err(_) => false,
         }
+    }
+
+    /// Appends the next fault of device 0 (see [`DeviceModel::push_fault`]).
+    pub fn push_fault(&mut self, fault: &Fault, seed: u64) -> Result<(), ScheduleFull> {
+        self.model.push_fault(fault, seed)
     }
 
     /// The chain's setup so far.
@@ -334,7 +381,9 @@ pub const DEFAULT_TEMP_C: f32 = 21.0;
 /// The image of one model step at `t_ns`, exactly as the device computes it in source mode (b),
 /// so a host can predict it: the model's sample, the field scaled to µT as
 /// `(f64::from(mag) * mag_ut_per_unit) as f32`, the temperature of the kinematics
-/// ([`DEFAULT_TEMP_C`] when absent), converted with the chip's current [`Chip::settings`].
+/// ([`DEFAULT_TEMP_C`] when absent), converted with the chip's current [`Chip::settings`]; the
+/// model's sensor faults act on the sample before the scaling and conversion (units: m/s²,
+/// rad/s, the scene's field unit), and a dropout's sensors get the chip's invalid value.
 pub fn model_image(
     model: &mut DeviceModel,
     t_ns: u64,
@@ -342,14 +391,23 @@ pub fn model_image(
     mag_ut_per_unit: f64,
     chip: &impl Chip,
 ) -> Image {
-    let s = model.sample(t_ns, truth);
+    let mut s = model.sample(t_ns, truth);
+    let dropout = match model.faults.as_mut() {
+        Some(f) if model.sensor_faults => f.apply(t_ns, &mut s),
+        _ => 0,
+    };
     let sample = PhysicalSample {
         acc: s.acc,
         gyr: s.gyr,
         mag: s.mag.map(|m| (f64::from(m) * mag_ut_per_unit) as f32),
         temp_c: truth.temperature_c.unwrap_or(DEFAULT_TEMP_C),
     };
-    chip.settings().image(&sample)
+    let settings = chip.settings();
+    let mut image = settings.image(&sample);
+    if dropout != 0 {
+        settings.mark_invalid(&mut image, dropout);
+    }
+    image
 }
 
 /// Whether the device can serve `source` (no perturbation in mode (b) yet).

@@ -4,6 +4,7 @@
 mod bmi088;
 mod bmi270;
 mod common;
+mod faults;
 mod fuzz_device;
 mod model;
 mod rig;

@@ -218,6 +218,9 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
         for piece in self.session.add_vibration_messages() {
             self.send(&Message::AddVibration(piece))?;
         }
+        for fault in self.session.add_fault_messages().to_vec() {
+            self.send(&Message::AddFault(fault))?;
+        }
         let timeout = self.plan.hello_timeout();
         let deadline = self.now() + timeout.as_nanos() as u64;
         while !self.reports.credit_seen() {

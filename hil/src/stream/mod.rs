@@ -80,6 +80,7 @@ pub mod clipping;
 pub mod clock;
 pub mod device_truth;
 mod ending;
+pub mod faults;
 mod flow;
 pub mod images;
 mod lateness;
@@ -101,6 +102,7 @@ mod source;
 pub mod virtual_port;
 pub mod window;
 
+pub use faults::fault_messages;
 pub use images::{predict_images, ImageSettings, PredictedSample};
 pub use lateness::Lateness;
 pub use logger::LogSink;

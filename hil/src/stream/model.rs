@@ -28,6 +28,11 @@
 //! ([`ModelPrediction::vibration`]); host and device build it with the one constructor
 //! `setup::model_chain`, so the images stay bit-identical.
 //!
+//! **Faults.** Device 0's faults of the scene's schedule go into the model ([`push_faults`],
+//! as the device does on AddFault, with the scene's seed), so its sensor faults act in
+//! `setup::model_image` on both sides alike; the session sends the schedule
+//! ([`fault_messages`](super::fault_messages)).
+//!
 //! Scenes the device cannot run are refused before anything is sent ([`StreamError::Model`]):
 //! a magnetic perturbation or random vibration (their FFT buffers do not fit a no-alloc
 //! device), more rpm points, tone sources or shocks than the device holds, a chain too slow for
@@ -56,6 +61,7 @@ use super::StreamError;
 use margemu_firmware::chip::{Chip, EmulatedChip};
 use margemu_firmware::link::setup::{self, ChainSetup, DeviceModel, ModelFront};
 use margemu_model::chain::Front;
+use margemu_model::fault::Fault;
 use margemu_model::sensor;
 use margemu_model::vibration::{Sense, ToneSource, MAX_SHOCKS, MAX_TONE_SOURCES};
 use margemu_protocol::link::{AddVibration, Image, ModelParams, Rate, RpmProfile, MAX_RPM_POINTS};
@@ -135,6 +141,7 @@ pub fn predict_model(
     let samples = Predictions::spawn(move |emit| {
         let mut model = DeviceModel::new(&params.marg, rate, params.seed, &chip, &chain)
             .map_err(margemu_sim::run::RunError::Model)?;
+        push_faults(&mut model, &scene.faults, scene.spec.seed);
         let temperature = scene.spec.sensors.temperature;
         let (mut k, mut held) = (0u64, None);
         run_scene(&scene, |truth| {
@@ -348,6 +355,19 @@ pub fn model_images(
     Ok(held
         .map(|(t_ns, t)| setup::model_image(&mut model, t_ns, t, params.mag_ut_per_unit, chip))
         .collect())
+}
+
+/// Gives `model` (device 0's, in source (b)) every fault of device 0 in `faults`, in order,
+/// with device 0's seed (the scene's `seed`), as the device does on AddFault: its sensor faults
+/// then act in [`setup::model_image`]. At most `MAX_FAULTS` are taken (the device refuses
+/// more).
+pub fn push_faults(model: &mut DeviceModel, faults: &[Fault], seed: u64) {
+    let seed = margemu_sim::marg::device_seed(seed, 0);
+    for f in faults.iter().filter(|f| f.device == 0) {
+        if model.push_fault(f, seed).is_err() {
+            break;
+        }
+    }
 }
 
 /// How many output samples each kinematics sample is held for: `rate / kinematics_hz`, which

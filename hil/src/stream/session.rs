@@ -106,6 +106,8 @@ pub struct Session {
     settings: ImageSettings,
     /// The items and their prediction.
     source: Source,
+    /// The AddFault messages of the scene's schedule.
+    faults: Vec<margemu_protocol::link::AddFault>,
     log: Logger,
     stop: Arc<AtomicBool>,
     /// Host time 0 of the logs; `None`: when the run begins.
@@ -122,6 +124,9 @@ impl Session {
             .images
             .unwrap_or_else(|| ImageSettings::for_scene(scene));
         let rate = rate_of(scene)?;
+        if let Some(reason) = super::faults::fault_refusal(scene) {
+            return Err(StreamError::Unsupported { reason });
+        }
         let (mut prediction, items, hold) = match config.source {
             SourceMode::Images => (
                 Prediction::images(predict_images(scene, &settings)),
@@ -170,6 +175,7 @@ impl Session {
             config,
             settings,
             source,
+            faults: super::faults::fault_messages(scene),
             log,
             stop: Arc::new(AtomicBool::new(false)),
             origin: None,
@@ -236,6 +242,11 @@ impl Session {
     /// One AddDevice per other device of a rig, to follow Configure.
     pub(super) fn add_device_messages(&self) -> Vec<margemu_protocol::link::AddDevice> {
         self.source.add_device_messages()
+    }
+
+    /// The AddFault messages of the scene's schedule, in order, to follow AddVibration.
+    pub(super) fn add_fault_messages(&self) -> &[margemu_protocol::link::AddFault] {
+        &self.faults
     }
 
     /// The AddVibration messages of source model, to follow Configure.

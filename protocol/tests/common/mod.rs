@@ -261,6 +261,58 @@ pub fn telemetry() -> impl Strategy<Value = Telemetry> {
         })
 }
 
+/// Any AddFault: a window of at least 1 ns, each kind with parameters in range.
+pub fn add_fault() -> impl Strategy<Value = AddFault> {
+    use margemu_model::fault::{Fault, FaultKind, Sensor, Window};
+    let sensor = (0..3u8).prop_map(|c| Sensor::from_code(c).unwrap());
+    let f = || -1e6f32..1e6;
+    let v = || [f(), f(), f()];
+    let kind = prop_oneof![
+        sensor
+            .clone()
+            .prop_map(|sensor| FaultKind::Stuck { sensor }),
+        (sensor.clone(), v()).prop_map(|(sensor, value)| FaultKind::StuckAt { sensor, value }),
+        sensor
+            .clone()
+            .prop_map(|sensor| FaultKind::Dropout { sensor }),
+        (sensor.clone(), f(), f(), 0..8u8).prop_map(|(sensor, rate_hz, amplitude, axes)| {
+            FaultKind::Spikes {
+                sensor,
+                rate_hz,
+                amplitude,
+                axes,
+            }
+        }),
+        (sensor.clone(), v()).prop_map(|(sensor, bias)| FaultKind::BiasStep { sensor, bias }),
+        (sensor.clone(), v()).prop_map(|(sensor, factor)| FaultKind::Scale { sensor, factor }),
+        (sensor, v()).prop_map(|(sensor, std)| FaultKind::Noise { sensor, std }),
+        v().prop_map(|field| FaultKind::MagSaturation { field }),
+        Just(FaultKind::Reset),
+        any::<u8>().prop_map(|value| FaultKind::WrongIdentity { value }),
+        Just(FaultKind::FifoOverflow),
+        Just(FaultKind::Nak),
+        f().prop_map(|probability| FaultKind::Corrupt { probability }),
+        any::<u32>().prop_map(|stretch_ns| FaultKind::ClockStretch { stretch_ns }),
+        (f(), f()).prop_map(|(ppm, drift_ppm_per_s)| FaultKind::ClockOffset {
+            ppm,
+            drift_ppm_per_s
+        }),
+        any::<u32>().prop_map(|max_ns| FaultKind::DrdyJitter { max_ns }),
+        f().prop_map(|probability| FaultKind::MissingDrdy { probability }),
+        any::<u32>().prop_map(|delay_ns| FaultKind::Late { delay_ns }),
+    ];
+    (any::<u8>(), any::<u64>(), 0..u64::MAX, 1..=u64::MAX, kind).prop_map(
+        |(device, seed, start, len, kind)| AddFault {
+            fault: Fault::new(
+                device,
+                Window::new(start, start.saturating_add(len).max(start + 1)),
+                kind,
+            ),
+            seed,
+        },
+    )
+}
+
 /// A message with owned batches; [`Owned::message`] borrows them.
 #[derive(Clone, Debug)]
 pub enum Owned {
@@ -296,6 +348,7 @@ pub fn message() -> impl Strategy<Value = Owned> {
             .prop_map(|(t0_ns, end_index)| Message::Start(Start { t0_ns, end_index }))
             .boxed()),
         m(Just(Message::Stop).boxed()),
+        m(add_fault().prop_map(Message::AddFault).boxed()),
         (any::<u64>(), images()).prop_map(|(i, v)| Owned::Images(i, v)),
         (
             any::<u64>(),

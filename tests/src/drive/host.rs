@@ -63,6 +63,9 @@ impl Host {
         for piece in &script.vibration {
             self.send(&Message::AddVibration(piece.clone()))?;
         }
+        for fault in &script.faults {
+            self.send(&Message::AddFault(*fault))?;
+        }
         self.wait("the first Credit", |h| h.credit_seen)?;
 
         let samples = script.samples;

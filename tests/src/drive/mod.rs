@@ -89,6 +89,8 @@ pub struct Script<'a> {
     pub configure: Configure,
     /// Sent after Configure, in order (source (b)'s sampling chain).
     pub vibration: Vec<margemu_protocol::link::AddVibration>,
+    /// Sent after the vibration, in order (the scene's fault schedule).
+    pub faults: Vec<margemu_protocol::link::AddFault>,
     /// The samples.
     pub samples: Samples<'a>,
     /// Rate of `samples`: the output rate for images, the truth rate for kinematics.

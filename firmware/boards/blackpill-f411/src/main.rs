@@ -153,11 +153,7 @@ fn main() -> ! {
                     shadow_stale = false;
                 }
             }
-            let chip = device.chip();
-            int.set(
-                chip.int_pin_at(device.scene_time_ns(now)),
-                chip.int_open_drain(),
-            );
+            int.set(device.int_pin_at(0, now), device.chip().int_open_drain());
             i2c::configure(device.rig());
         });
         stats.dropped = spi.dropped();

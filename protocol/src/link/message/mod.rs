@@ -12,6 +12,7 @@
 //! | 0x04 | [`Message::Stop`] | host → device |
 //! | 0x05 | [`AddDevice`] | host → device |
 //! | 0x06 | [`AddVibration`] | host → device |
+//! | 0x07 | [`AddFault`] | host → device |
 //! | 0x10 | [`ImageBatch`] | host → device |
 //! | 0x11 | [`KinematicsBatch`] | host → device |
 //! | 0x81 | [`HelloAck`] | device → host |
@@ -39,6 +40,7 @@ mod macros;
 mod batch;
 mod configure;
 mod device;
+mod fault;
 mod images;
 mod model_terms;
 mod session;
@@ -53,6 +55,7 @@ pub use batch::{
 pub use configure::{Configure, ModelParams, Rate, RegisterOverride, Source};
 pub use configure::{MAX_CONFIGURE_LEN, MAX_OVERRIDES};
 pub use device::{AddDevice, DeviceBus, MAX_DEVICES, MAX_DEVICE_OVERRIDES};
+pub use fault::{kind_code as fault_kind_code, AddFault};
 pub use images::{
     max_images_per_batch, Image, ImageBatch, ImageItems, IMAGE_BATCH_HEADER_LEN, MAX_IMAGE_LEN,
 };
@@ -82,6 +85,8 @@ code_enum! {
         AddDevice = 0x05,
         /// [`AddVibration`].
         AddVibration = 0x06,
+        /// [`AddFault`].
+        AddFault = 0x07,
         /// [`ImageBatch`].
         Images = 0x10,
         /// [`KinematicsBatch`].
@@ -129,6 +134,8 @@ pub enum Message<'a> {
     AddDevice(AddDevice),
     /// Host: one piece of the source-(b) sampling chain.
     AddVibration(AddVibration),
+    /// Host: one scripted fault of the schedule.
+    AddFault(AddFault),
     /// Host: finished register images.
     Images(ImageBatch<'a>),
     /// Host: true kinematics for the on-device model.
@@ -159,6 +166,7 @@ impl<'a> Message<'a> {
             Self::Stop => Kind::Stop,
             Self::AddDevice(_) => Kind::AddDevice,
             Self::AddVibration(_) => Kind::AddVibration,
+            Self::AddFault(_) => Kind::AddFault,
             Self::Images(_) => Kind::Images,
             Self::Kinematics(_) => Kind::Kinematics,
             Self::HelloAck(_) => Kind::HelloAck,
@@ -187,6 +195,7 @@ impl<'a> Message<'a> {
             Kind::Stop => Self::Stop,
             Kind::AddDevice => Self::AddDevice(AddDevice::parse(&mut r)?),
             Kind::AddVibration => Self::AddVibration(AddVibration::parse(&mut r)?),
+            Kind::AddFault => Self::AddFault(AddFault::parse(&mut r)?),
             Kind::Images => Self::Images(ImageBatch::parse(&mut r)?),
             Kind::Kinematics => Self::Kinematics(KinematicsBatch::parse(&mut r)?),
             Kind::HelloAck => Self::HelloAck(HelloAck::parse(&mut r)?),
@@ -210,6 +219,7 @@ impl<'a> Message<'a> {
             Self::Stop => 0,
             Self::AddDevice(m) => m.buffer_len(),
             Self::AddVibration(m) => m.buffer_len(),
+            Self::AddFault(m) => m.buffer_len(),
             Self::Images(m) => m.buffer_len(),
             Self::Kinematics(m) => m.buffer_len(),
             Self::HelloAck(_) => HelloAck::LEN,
@@ -233,6 +243,7 @@ impl<'a> Message<'a> {
             Self::Stop => Ok(()),
             Self::AddDevice(m) => m.emit(&mut w),
             Self::AddVibration(m) => m.emit(&mut w),
+            Self::AddFault(m) => m.emit(&mut w),
             Self::Images(m) => m.emit(&mut w),
             Self::Kinematics(m) => m.emit(&mut w),
             Self::HelloAck(m) => m.emit(&mut w),

@@ -315,6 +315,10 @@ code_enum! {
         /// would be too long (`detail`: 1 full, 2 I2C address taken, 3 chip select taken, 4
         /// model source, 5 image over [`MAX_IMAGE_LEN`](crate::chip::MAX_IMAGE_LEN)).
         RigRefused = 10,
+        /// [`AddFault`](super::AddFault) refused (`detail`: 1 the schedule is full, 2 it
+        /// overlaps a fault it may not overlap, 3 no such device in the rig, 4 the device's chip
+        /// cannot apply this chip fault; `docs/spec/link.md` §5.16).
+        FaultRefused = 11,
     }
 }
 
