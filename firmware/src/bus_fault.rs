@@ -1,0 +1,256 @@
+//! Bus faults applied to a chip's bus target: the one application of the schedule's `nak`,
+//! `corrupt` and `clock_stretch` faults ([`margemu_model::fault::FaultKind`]), used by the
+//! firmware's board paths and by the host's virtual buses (`margemu_hil::bus`) alike, so a
+//! driver sees the same bytes on both.
+//!
+//! [`BusFaults`] holds one device's bus faults (taken from the rig's [`FaultSchedule`] with
+//! [`BusFaults::for_device`] or kept up to date with [`BusFaults::sync`]) and the state they need
+//! between bus events; [`BusFaults::on`] wraps the device's target for one or more bus events at
+//! one instant into a [`Faulted`] target, itself an [`SpiTarget`] and an [`I2cTarget`].
+//!
+//! **The instant of a bus event** is the one its caller passes to [`BusFaults::on`]: the chip's
+//! scene clock ([`Chip::now_ns`](crate::chip::Chip::now_ns)), on the board and on the host, so a
+//! window of scene time covers the same transactions in both.
+//!
+//! **What each kind does:**
+//! - `nak`: on I2C the chip does not acknowledge any of its addresses at a START (or repeated
+//!   START) inside the window, so the controller sees NoAcknowledge of the address; the chip
+//!   sees neither that START nor the bytes up to the next START (writes are NACKed, reads find
+//!   the released line, [`RELEASED`]); STOP reaches it. On SPI the chip is dead for any
+//!   transaction whose chip select falls in the window: it sees nothing, drives nothing, and
+//!   MISO reads [`RELEASED`] (`0xFF`) on every byte. That is what a controller reads from an
+//!   undriven MISO on the boards margemu targets: the flight controllers' STM32 SPI
+//!   configurations (Betaflight's and ArduPilot's ChibiOS board files) put a pull-up on the MISO
+//!   pin, and the drivers' probes treat a WHO_AM_I of `0xFF` as "no chip".
+//! - `corrupt { probability }`: each byte the chip drives (every MISO byte of a selection,
+//!   every byte the controller reads on I2C) inside the window has one bit flipped with that
+//!   probability. The draws come from the fault's own stream ([`ScheduledFault::rng`]), in
+//!   order, per driven byte: one [`unit_f64`] draw `u`; if `u < probability`, a second draw
+//!   `v` picks the bit `floor(8 v)` (0 = LSB). The stream advances only on bytes inside its
+//!   window, so the same transactions corrupt the same bits on every run.
+//! - `clock_stretch { stretch_ns }`: on I2C the chip holds SCL low `stretch_ns` before each
+//!   byte it drives (each byte the controller reads), counted in
+//!   [`BusFaults::take_stretch_ns`] for the caller to spend (a board waits that long before
+//!   it loads the byte; the host's virtual bus advances its clock and applies its
+//!   controller's timeout). SPI has no clock stretching: on an SPI target it does nothing.
+//!
+//! With no fault active at the instant, the target's bytes pass unchanged and no draw is made.
+
+use crate::chip::{I2cTarget, SpiTarget};
+use crate::fault::{FaultSchedule, ScheduledFault};
+use margemu_model::fault::{FaultKind, Window, MAX_FAULTS};
+use margemu_model::rng::{unit_f64, StreamRng};
+
+/// What a controller reads from a line nobody drives (MISO with its pull-up, the released
+/// open-drain SDA): `0xFF`.
+pub const RELEASED: u8 = 0xFF;
+
+/// One bus fault of the device.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Entry {
+    window: Window,
+    effect: Effect,
+    /// The fault, for its random stream.
+    fault: ScheduledFault,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Effect {
+    Nak,
+    Corrupt(f64),
+    Stretch(u32),
+}
+
+/// One device's bus faults and their state between bus events (see the module docs).
+#[derive(Clone, Debug)]
+pub struct BusFaults {
+    device: u8,
+    faults: heapless::Vec<Entry, MAX_FAULTS>,
+    /// How many of the device's schedule entries [`BusFaults::sync`] has looked at.
+    seen: usize,
+    /// The stream of the corrupt fault in use (its index among the device's faults). Corrupt
+    /// faults of one device never overlap, and time only moves forward, so one is enough.
+    stream: Option<(u8, StreamRng)>,
+    /// The current selection (SPI) or START (I2C) was not acknowledged: the chip is absent.
+    absent: bool,
+    /// Stretch owed to the bus since the last [`BusFaults::take_stretch_ns`].
+    stretch_ns: u64,
+}
+
+impl BusFaults {
+    /// No faults, for device `device` of the rig.
+    pub const fn new(device: u8) -> Self {
+        Self {
+            device,
+            faults: heapless::Vec::new(),
+            seen: 0,
+            stream: None,
+            absent: false,
+            stretch_ns: 0,
+        }
+    }
+
+    /// Device `device`'s bus faults in `schedule`.
+    pub fn for_device(schedule: &FaultSchedule, device: u8) -> Self {
+        let mut faults = Self::new(device);
+        faults.sync(schedule);
+        faults
+    }
+
+    /// Takes the device's faults `schedule` gained since the last call; starts over when the
+    /// schedule holds fewer than it did (it was cleared by a new Configure). Cheap when nothing
+    /// changed: it counts the device's entries.
+    pub fn sync(&mut self, schedule: &FaultSchedule) {
+        let held = schedule.for_device(self.device).count();
+        if held < self.seen {
+            *self = Self::new(self.device);
+        }
+        for e in schedule.for_device(self.device).skip(self.seen) {
+            let effect = match e.fault.kind {
+                FaultKind::Nak => Effect::Nak,
+                FaultKind::Corrupt { probability } => Effect::Corrupt(f64::from(probability)),
+                FaultKind::ClockStretch { stretch_ns } => Effect::Stretch(stretch_ns),
+                _ => continue,
+            };
+            let entry = Entry {
+                window: e.fault.window,
+                effect,
+                fault: *e,
+            };
+            // Never full: the schedule holds at most as many faults in all.
+            let _ = self.faults.push(entry);
+        }
+        self.seen = held;
+    }
+
+    /// The rig's device these faults belong to.
+    pub fn device(&self) -> u8 {
+        self.device
+    }
+
+    /// Whether the device has no bus fault at all.
+    pub fn is_empty(&self) -> bool {
+        self.faults.is_empty()
+    }
+
+    fn active(&self, t_ns: u64) -> impl Iterator<Item = &Entry> {
+        self.faults.iter().filter(move |e| e.window.contains(t_ns))
+    }
+
+    /// Whether the chip refuses its bus at `t_ns` (a `nak` window).
+    pub fn nak(&self, t_ns: u64) -> bool {
+        self.active(t_ns).any(|e| e.effect == Effect::Nak)
+    }
+
+    /// How long the chip stretches SCL before each byte it drives at `t_ns`.
+    pub fn stretch_ns(&self, t_ns: u64) -> u32 {
+        self.active(t_ns)
+            .map(|e| match e.effect {
+                Effect::Stretch(ns) => ns,
+                _ => 0,
+            })
+            .fold(0, u32::saturating_add)
+    }
+
+    /// The stretch owed to the bus since the last call (the sum over the bytes driven).
+    pub fn take_stretch_ns(&mut self) -> u64 {
+        core::mem::take(&mut self.stretch_ns)
+    }
+
+    /// `byte`, driven by the chip at `t_ns`, as the controller receives it (`corrupt`).
+    pub fn drive(&mut self, t_ns: u64, byte: u8) -> u8 {
+        let Some((probability, fault)) = self.active(t_ns).find_map(|e| match e.effect {
+            Effect::Corrupt(p) => Some((p, e.fault)),
+            _ => None,
+        }) else {
+            return byte;
+        };
+        if self.stream.as_ref().map(|(index, _)| *index) != Some(fault.index) {
+            self.stream = Some((fault.index, fault.rng()));
+        }
+        let Some((_, rng)) = &mut self.stream else {
+            return byte;
+        };
+        if unit_f64(rng) < probability {
+            let bit = (unit_f64(rng) * 8.0) as u32; // in 0..8: the draw is below 1
+            byte ^ 1u8.wrapping_shl(bit)
+        } else {
+            byte
+        }
+    }
+
+    /// `target` with these faults, for bus events at the instant `now_ns`.
+    pub fn on<'a, T: ?Sized>(&'a mut self, target: &'a mut T, now_ns: u64) -> Faulted<'a, T> {
+        Faulted {
+            target,
+            faults: self,
+            now_ns,
+        }
+    }
+
+    /// A byte the chip drives on I2C: stretched, then corrupted.
+    fn drive_i2c(&mut self, t_ns: u64, byte: u8) -> u8 {
+        let stretch = u64::from(self.stretch_ns(t_ns));
+        self.stretch_ns = self.stretch_ns.saturating_add(stretch);
+        self.drive(t_ns, byte)
+    }
+}
+
+/// A target seen through its device's [`BusFaults`] at one instant ([`BusFaults::on`]).
+pub struct Faulted<'a, T: ?Sized> {
+    target: &'a mut T,
+    faults: &'a mut BusFaults,
+    now_ns: u64,
+}
+
+impl<T: SpiTarget + ?Sized> SpiTarget for Faulted<'_, T> {
+    fn select(&mut self) -> u8 {
+        self.faults.absent = self.faults.nak(self.now_ns);
+        if self.faults.absent {
+            return RELEASED;
+        }
+        let miso = self.target.select();
+        self.faults.drive(self.now_ns, miso)
+    }
+
+    fn exchange(&mut self, mosi: u8) -> u8 {
+        if self.faults.absent {
+            return RELEASED;
+        }
+        let miso = self.target.exchange(mosi);
+        self.faults.drive(self.now_ns, miso)
+    }
+
+    fn deselect(&mut self) {
+        if !core::mem::take(&mut self.faults.absent) {
+            self.target.deselect();
+        }
+    }
+}
+
+impl<T: I2cTarget + ?Sized> I2cTarget for Faulted<'_, T> {
+    fn start(&mut self, address: u8, read: bool) -> bool {
+        self.faults.absent = self.faults.nak(self.now_ns);
+        !self.faults.absent && self.target.start(address, read)
+    }
+
+    fn write(&mut self, byte: u8) -> bool {
+        !self.faults.absent && self.target.write(byte)
+    }
+
+    fn read(&mut self) -> u8 {
+        if self.faults.absent {
+            return RELEASED;
+        }
+        let byte = self.target.read();
+        self.faults.drive_i2c(self.now_ns, byte)
+    }
+
+    fn stop(&mut self) {
+        self.faults.absent = false;
+        self.target.stop();
+    }
+}
+
+#[cfg(test)]
+mod tests;
