@@ -53,6 +53,7 @@
 //! [`I2cTarget`]: margemu_firmware::chip::I2cTarget
 
 mod delay;
+mod faults;
 mod i2c;
 mod i2c_bus;
 mod spi;
