@@ -27,7 +27,9 @@
 //!   probability. The draws come from the fault's own stream ([`ScheduledFault::rng`]), in
 //!   order, per driven byte: one [`unit_f64`] draw `u`; if `u < probability`, a second draw
 //!   `v` picks the bit `floor(8 v)` (0 = LSB). The stream advances only on bytes inside its
-//!   window, so the same transactions corrupt the same bits on every run.
+//!   window, so the same transactions corrupt the same bits on every run. On SPI the driven
+//!   bytes are those the chip prepares ([`SpiTarget`]'s contract): one at select and one after
+//!   each byte clocked, the last of which the controller never clocks out; each takes its draw.
 //! - `clock_stretch { stretch_ns }`: on I2C the chip holds SCL low `stretch_ns` before each
 //!   byte it drives (each byte the controller reads), counted in
 //!   [`BusFaults::take_stretch_ns`] for the caller to spend (a board waits that long before
@@ -201,6 +203,18 @@ pub struct Faulted<'a, T: ?Sized> {
     target: &'a mut T,
     faults: &'a mut BusFaults,
     now_ns: u64,
+}
+
+impl<T: ?Sized> Faulted<'_, T> {
+    /// The instant of its bus events.
+    pub fn now_ns(&self) -> u64 {
+        self.now_ns
+    }
+
+    /// [`BusFaults::take_stretch_ns`]: the stretch its bytes owe the bus so far.
+    pub fn take_stretch_ns(&mut self) -> u64 {
+        self.faults.take_stretch_ns()
+    }
 }
 
 impl<T: SpiTarget + ?Sized> SpiTarget for Faulted<'_, T> {
