@@ -197,7 +197,7 @@ fn corrupt_through_spi_bus_and_chip_select_flips_the_streams_bits() {
     let twin = bus::shared(Icm42688p::new());
     let (s, corrupt) = faults(0, &[(500, 600, FaultKind::Corrupt { probability: 0.25 })]);
     let (mut spi, mut cs) = SpiBus::new(chip.clone());
-    spi.set_faults(corrupt);
+    spi.faults().set(corrupt);
     let mut clean = SpiDevice::new(twin);
     let mut rng = s.iter().next().unwrap().rng();
     let selection = |cs: &mut bus::ChipSelect<Icm42688p>, spi: &mut SpiBus<Icm42688p>| {

@@ -90,6 +90,7 @@ use margemu_protocol::link::{
 use margemu_protocol::PROTOCOL_VERSION;
 
 use crate::chip::{self, EmulatedChip};
+use crate::fault::FaultSchedule;
 use rig::Rig;
 use setup::Model;
 
@@ -189,6 +190,7 @@ pub struct Device<const N: usize = 128> {
 
 struct Core<const N: usize> {
     rig: Rig,
+    faults: FaultSchedule,
     identity: Identity,
     state: DeviceState,
     session: Option<Session>,
@@ -236,6 +238,7 @@ impl<const N: usize> Device<N> {
             rx: Accumulator::new(),
             core: Core {
                 rig: Rig::new(EmulatedChip::default()),
+                faults: FaultSchedule::new(),
                 identity,
                 state: DeviceState::Idle,
                 session: None,
@@ -302,6 +305,11 @@ impl<const N: usize> Device<N> {
     /// [`Rig::i2c_target`]).
     pub fn rig_mut(&mut self) -> &mut Rig {
         &mut self.core.rig
+    }
+
+    /// The rig's fault schedule.
+    pub fn faults(&self) -> &FaultSchedule {
+        &self.core.faults
     }
 
     /// The counters.

@@ -5,7 +5,8 @@
 //! START and the address go before each change of direction; STOP ends it, also after a NACK,
 //! which aborts the rest.
 //!
-//! **Bus faults.** Given the device's faults ([`I2c::with_faults`], [`I2c::sync_faults`]), the
+//! **Bus faults.** Given the device's faults ([`I2c::with_faults`], or later through its
+//! [`BusFaultsHandle`]), the
 //! adapter drives the target through [`margemu_firmware::bus_fault`] at the chip's scene clock
 //! ([`Chip::now_ns`]) when the transaction begins: in a `nak` window the address is not
 //! acknowledged ([`I2cError::AddressNack`]); `corrupt` flips bits of the bytes read;
@@ -17,12 +18,11 @@
 //! would use 25 ms, the SMBus clock-low timeout, and a Linux or ChibiOS controller its
 //! transfer timeout).
 
-use super::faults::{self, TargetFaults};
+use super::faults::BusFaultsHandle;
 use super::{Clock, Shared};
 use embedded_hal::i2c::{self, ErrorKind, NoAcknowledgeSource, Operation, SevenBitAddress};
 use margemu_firmware::bus_fault::{BusFaults, Faulted};
 use margemu_firmware::chip::{Chip, I2cTarget};
-use margemu_firmware::fault::FaultSchedule;
 
 /// An I2C access that failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error, docsplay::Display)]
@@ -64,7 +64,7 @@ impl i2c::Error for I2cError {
 /// [`I2cError::AddressNack`] without touching the bus.
 pub struct I2c<T> {
     target: Shared<T>,
-    faults: Option<TargetFaults<T>>,
+    faults: BusFaultsHandle<T>,
     clock: Option<Clock>,
     timeout_ns: Option<u64>,
 }
@@ -74,7 +74,7 @@ impl<T> I2c<T> {
     pub fn new(target: Shared<T>) -> Self {
         Self {
             target,
-            faults: None,
+            faults: BusFaultsHandle::default(),
             clock: None,
             timeout_ns: None,
         }
@@ -83,6 +83,11 @@ impl<T> I2c<T> {
     /// The target.
     pub fn target(&self) -> &Shared<T> {
         &self.target
+    }
+
+    /// Its bus faults (a handle that shares them).
+    pub fn faults(&self) -> BusFaultsHandle<T> {
+        self.faults.clone()
     }
 
     /// Makes the target's clock stretching advance `clock`.
@@ -100,14 +105,9 @@ impl<T> I2c<T> {
 
 impl<T: Chip> I2c<T> {
     /// Drives the chip through its device's bus `faults` (module docs).
-    pub fn with_faults(mut self, faults: BusFaults) -> Self {
-        self.faults = Some(TargetFaults::new(faults));
+    pub fn with_faults(self, faults: BusFaults) -> Self {
+        self.faults.set(faults);
         self
-    }
-
-    /// Takes device `device`'s bus faults from `schedule` (those added since the last call).
-    pub fn sync_faults(&mut self, schedule: &FaultSchedule, device: u8) {
-        faults::sync(&mut self.faults, schedule, device);
     }
 }
 
@@ -137,7 +137,8 @@ impl<T: I2cTarget> i2c::I2c<SevenBitAddress> for I2c<T> {
             address,
             total_ns: 0,
         };
-        let mut line = match &mut self.faults {
+        let mut faults = self.faults.borrow().ok_or(I2cError::TargetBusy)?;
+        let mut line = match &mut *faults {
             Some(faults) => Line::Faulted(faults.on(&mut target)),
             None => Line::Plain(&mut *target),
         };

@@ -5,21 +5,20 @@
 //! MISO floats high, so the controller reads `0xFF` (as with a pull-up on real boards,
 //! [`RELEASED`]).
 //!
-//! **Bus faults.** Given the device's faults ([`SpiDevice::with_faults`],
-//! [`SpiBus::set_faults`], [`SpiDevice::sync_faults`]), the adapters drive the target through
+//! **Bus faults.** Given the device's faults ([`SpiDevice::with_faults`], or later through
+//! the adapter's [`BusFaultsHandle`]), the adapters drive the target through
 //! [`margemu_firmware::bus_fault`], at the chip's scene clock ([`Chip::now_ns`]) when the
 //! transaction (or bus call) begins: a `nak` window makes the chip dead (MISO `0xFF`, the chip
 //! sees nothing), `corrupt` flips bits of MISO bytes, `clock_stretch` does nothing (SPI has no
 //! clock stretching).
 
-use super::faults::{self, TargetFaults};
+use super::faults::BusFaultsHandle;
 use super::{Clock, Shared};
 use embedded_hal::digital::{self, OutputPin, StatefulOutputPin};
 use embedded_hal::spi::{self, ErrorKind, Operation};
 use margemu_firmware::bus_fault::{BusFaults, RELEASED};
 use margemu_firmware::chip::{Chip, SpiTarget};
-use margemu_firmware::fault::FaultSchedule;
-use std::cell::{Cell, RefCell, RefMut};
+use std::cell::{Cell, RefMut};
 use std::rc::Rc;
 
 /// MOSI byte clocked out while the controller only reads.
@@ -83,7 +82,7 @@ fn transfer_in_place<T: SpiTarget + ?Sized>(target: &mut T, next: &mut u8, words
 pub struct SpiDevice<T> {
     target: Shared<T>,
     clock: Option<Clock>,
-    faults: Option<TargetFaults<T>>,
+    faults: BusFaultsHandle<T>,
 }
 
 impl<T> SpiDevice<T> {
@@ -92,7 +91,7 @@ impl<T> SpiDevice<T> {
         Self {
             target,
             clock: None,
-            faults: None,
+            faults: BusFaultsHandle::default(),
         }
     }
 
@@ -106,18 +105,18 @@ impl<T> SpiDevice<T> {
     pub fn target(&self) -> &Shared<T> {
         &self.target
     }
+
+    /// Its bus faults (a handle that shares them).
+    pub fn faults(&self) -> BusFaultsHandle<T> {
+        self.faults.clone()
+    }
 }
 
 impl<T: Chip> SpiDevice<T> {
     /// Drives the chip through its device's bus `faults` (module docs).
-    pub fn with_faults(mut self, faults: BusFaults) -> Self {
-        self.faults = Some(TargetFaults::new(faults));
+    pub fn with_faults(self, faults: BusFaults) -> Self {
+        self.faults.set(faults);
         self
-    }
-
-    /// Takes device `device`'s bus faults from `schedule` (those added since the last call).
-    pub fn sync_faults(&mut self, schedule: &FaultSchedule, device: u8) {
-        faults::sync(&mut self.faults, schedule, device);
     }
 }
 
@@ -129,7 +128,8 @@ impl<T: SpiTarget> spi::SpiDevice<u8> for SpiDevice<T> {
     fn transaction(&mut self, operations: &mut [Operation<'_, u8>]) -> Result<(), SpiError> {
         let mut target = borrow(&self.target)?;
         let clock = self.clock.as_ref();
-        match &mut self.faults {
+        let mut faults = self.faults.borrow().ok_or(SpiError::TargetBusy)?;
+        match &mut *faults {
             Some(faults) => selection(&mut faults.on(&mut target), operations, clock),
             None => selection(&mut *target, operations, clock),
         }
@@ -164,15 +164,12 @@ fn selection<T: SpiTarget + ?Sized>(
 /// else the MISO byte the target prepared for the next byte.
 type Line = Rc<Cell<Option<u8>>>;
 
-/// The bus faults shared by an [`SpiBus`] and its [`ChipSelect`].
-type SharedFaults<T> = Rc<RefCell<Option<TargetFaults<T>>>>;
-
 /// `embedded_hal::spi::SpiBus` over a target whose chip select is the paired [`ChipSelect`].
 /// The bytes of one selection may be spread over any number of bus calls.
 pub struct SpiBus<T> {
     target: Shared<T>,
     line: Line,
-    faults: SharedFaults<T>,
+    faults: BusFaultsHandle<T>,
 }
 
 /// The chip-select pin of an [`SpiBus`] (active low): `set_low` selects the target,
@@ -180,14 +177,14 @@ pub struct SpiBus<T> {
 pub struct ChipSelect<T> {
     target: Shared<T>,
     line: Line,
-    faults: SharedFaults<T>,
+    faults: BusFaultsHandle<T>,
 }
 
 impl<T> SpiBus<T> {
     /// A bus on `target` and its chip-select pin, released.
     pub fn new(target: Shared<T>) -> (Self, ChipSelect<T>) {
         let line = Line::default();
-        let faults = SharedFaults::default();
+        let faults = BusFaultsHandle::default();
         let cs = ChipSelect {
             target: target.clone(),
             line: line.clone(),
@@ -205,18 +202,10 @@ impl<T> SpiBus<T> {
     pub fn target(&self) -> &Shared<T> {
         &self.target
     }
-}
 
-impl<T: Chip> SpiBus<T> {
-    /// Drives the chip (from this bus and its chip select) through its device's bus `faults`
-    /// (module docs).
-    pub fn set_faults(&mut self, faults: BusFaults) {
-        *self.faults.borrow_mut() = Some(TargetFaults::new(faults));
-    }
-
-    /// Takes device `device`'s bus faults from `schedule` (those added since the last call).
-    pub fn sync_faults(&mut self, schedule: &FaultSchedule, device: u8) {
-        faults::sync(&mut self.faults.borrow_mut(), schedule, device);
+    /// Its bus faults, shared with its chip select (module docs).
+    pub fn faults(&self) -> BusFaultsHandle<T> {
+        self.faults.clone()
     }
 }
 
@@ -231,7 +220,7 @@ impl<T: SpiTarget> SpiBus<T> {
             None => f(None),
             Some(mut next) => {
                 let mut target = borrow(&self.target)?;
-                match &mut *borrow(&self.faults)? {
+                match &mut *self.faults.borrow().ok_or(SpiError::TargetBusy)? {
                     Some(faults) => f(Some((&mut faults.on(&mut target), &mut next))),
                     None => f(Some((&mut *target, &mut next))),
                 }
@@ -289,10 +278,12 @@ impl<T: SpiTarget> ChipSelect<T> {
     /// Runs `f` on the target, through its faults if any.
     fn edge<R>(&mut self, f: impl FnOnce(&mut dyn SpiTarget) -> R) -> Result<R, SpiError> {
         let mut target = borrow(&self.target)?;
-        Ok(match &mut *borrow(&self.faults)? {
-            Some(faults) => f(&mut faults.on(&mut target)),
-            None => f(&mut *target),
-        })
+        Ok(
+            match &mut *self.faults.borrow().ok_or(SpiError::TargetBusy)? {
+                Some(faults) => f(&mut faults.on(&mut target)),
+                None => f(&mut *target),
+            },
+        )
     }
 }
 
