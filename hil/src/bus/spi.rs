@@ -120,6 +120,15 @@ impl<T: Chip> SpiDevice<T> {
     }
 }
 
+impl<T> SpiDevice<T> {
+    /// Applies the faults `handle` shares with another adapter on the same chip (so the two
+    /// draw from one stream, as the chip's one bus target does).
+    pub fn sharing_faults(mut self, handle: BusFaultsHandle<T>) -> Self {
+        self.faults = handle;
+        self
+    }
+}
+
 impl<T> spi::ErrorType for SpiDevice<T> {
     type Error = SpiError;
 }

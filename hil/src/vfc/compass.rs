@@ -56,7 +56,8 @@
 use super::board::on_bus;
 use crate::bus::{self, Shared};
 use embedded_hal::i2c::I2c as _;
-use margemu_firmware::chip::EmulatedChip;
+use margemu_firmware::chip::{Chip as _, EmulatedChip};
+use margemu_firmware::fault::FaultSchedule;
 use margemu_firmware::link::rig::Rig;
 use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion};
 use margemu_protocol::regmap::mag_image;
@@ -213,6 +214,18 @@ impl Compass {
         };
         self.next_poll_ns = now_ns + PERIOD_NS;
         Ok(Some(rotate(&self.config.to_body, ut)))
+    }
+
+    /// Keeps the bus faults of its I2C bus those of the rig's device at its address in
+    /// `schedule` (none while no device answers it).
+    pub fn sync_faults(&self, rig: &Rig, schedule: &FaultSchedule) {
+        let address = Some(self.config.address);
+        let device = rig
+            .chips()
+            .position(|c| c.i2c_addresses_now().contains(&address));
+        if let Some(device) = device.and_then(|d| u8::try_from(d).ok()) {
+            self.i2c.faults().sync(schedule, device);
+        }
     }
 
     /// Polls that found no new measurement so far.

@@ -217,6 +217,7 @@ impl VirtualFc {
         let Some(board) = &mut self.board else {
             return Ok(());
         };
+        board.sync_faults(device.faults());
         let chip: &mut EmulatedChip = device.chip_mut();
         if !board.data_ready(chip)? {
             return Ok(());
@@ -291,6 +292,7 @@ impl VirtualFc {
         let Some(compass) = &mut self.compass else {
             return Ok(());
         };
+        compass.sync_faults(device.rig(), device.faults());
         let before = compass.not_ready();
         let reading = compass.poll(device.rig_mut(), now_ns)?;
         let not_ready = compass.not_ready();

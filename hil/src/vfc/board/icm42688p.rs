@@ -111,6 +111,8 @@ pub struct Board {
     /// The device's chip during a transaction batch; a spare part otherwise.
     slot: Shared<Chip>,
     driver: Driver,
+    /// The bus faults of the driver's SPI device.
+    faults: bus::BusFaultsHandle<Chip>,
     overflows: u64,
 }
 
@@ -151,7 +153,9 @@ impl Board {
                 rate: odr,
                 timestamps_are_absolute: false,
             };
-            let mut driver = ICM42688::new(bus::SpiDevice::new(slot.clone()))
+            let spi = bus::SpiDevice::new(slot.clone());
+            let faults = spi.faults();
+            let mut driver = ICM42688::new(spi)
                 .initialize(bus::Delay::with_clock(clock.clone()), config)
                 .map_err(|e| format!("{e:?}"))?;
             let who_am_i = driver
@@ -169,6 +173,7 @@ impl Board {
             let board = Self {
                 slot: slot.clone(),
                 driver,
+                faults,
                 overflows: 0,
             };
             Ok((board, report))
@@ -188,6 +193,7 @@ impl Board {
             slot,
             driver,
             overflows,
+            ..
         } = self;
         on_bus(slot, chip, || {
             let mut out = Vec::new();
@@ -214,6 +220,11 @@ impl Board {
                 }
             }
         })
+    }
+
+    /// The bus faults of its SPI device.
+    pub fn faults(&self) -> &bus::BusFaultsHandle<Chip> {
+        &self.faults
     }
 
     /// FIFO overflows so far.
