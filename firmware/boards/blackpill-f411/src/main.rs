@@ -158,7 +158,7 @@ fn main() -> ! {
                 chip.int_pin_at(device.scene_time_ns(now)),
                 chip.int_open_drain(),
             );
-            i2c::configure(device.rig());
+            i2c::configure(device.rig(), device.faults());
         });
         stats.dropped = spi.dropped();
         // SAFETY: the main loop is the only writer (see `StatsCell`).
