@@ -27,7 +27,9 @@
 //!   probability. The draws come from the fault's own stream ([`ScheduledFault::rng`]), in
 //!   order, per driven byte: one [`unit_f64`] draw `u`; if `u < probability`, a second draw
 //!   `v` picks the bit `floor(8 v)` (0 = LSB). The stream advances only on bytes inside its
-//!   window, so the same transactions corrupt the same bits on every run. On SPI the driven
+//!   window, so the same transactions corrupt the same bits on every run. Time moves forward
+//!   within a run: a byte at an instant before the stream's last draw (a new run of the same
+//!   schedule) starts the stream again. On SPI the driven
 //!   bytes are those the chip prepares ([`SpiTarget`]'s contract): one at select and one after
 //!   each byte clocked, the last of which the controller never clocks out; each takes its draw.
 //! - `clock_stretch { stretch_ns }`: on I2C the chip holds SCL low `stretch_ns` before each
@@ -68,11 +70,10 @@ enum Effect {
 pub struct BusFaults {
     device: u8,
     faults: heapless::Vec<Entry, MAX_FAULTS>,
-    /// How many of the device's schedule entries [`BusFaults::sync`] has looked at.
-    seen: usize,
-    /// The stream of the corrupt fault in use (its index among the device's faults). Corrupt
-    /// faults of one device never overlap, and time only moves forward, so one is enough.
-    stream: Option<(u8, StreamRng)>,
+    /// The stream of the corrupt fault in use (its index among the device's faults) and the
+    /// instant of its last draw. Corrupt faults of one device never overlap, and time only
+    /// moves forward within a run, so one is enough.
+    stream: Option<(u8, StreamRng, u64)>,
     /// The current selection (SPI) or START (I2C) was not acknowledged: the chip is absent.
     absent: bool,
     /// Stretch owed to the bus since the last [`BusFaults::take_stretch_ns`].
@@ -85,7 +86,6 @@ impl BusFaults {
         Self {
             device,
             faults: heapless::Vec::new(),
-            seen: 0,
             stream: None,
             absent: false,
             stretch_ns: 0,
@@ -99,15 +99,11 @@ impl BusFaults {
         faults
     }
 
-    /// Takes the device's faults `schedule` gained since the last call; starts over when the
-    /// schedule holds fewer than it did (it was cleared by a new Configure). Cheap when nothing
-    /// changed: it counts the device's entries.
+    /// Makes them the device's bus faults in `schedule` (as it is now: a fault added, or a new
+    /// Configure's schedule). The faults held on stay as they are, with their streams.
     pub fn sync(&mut self, schedule: &FaultSchedule) {
-        let held = schedule.for_device(self.device).count();
-        if held < self.seen {
-            *self = Self::new(self.device);
-        }
-        for e in schedule.for_device(self.device).skip(self.seen) {
+        let mut fresh = heapless::Vec::<Entry, MAX_FAULTS>::new();
+        for e in schedule.for_device(self.device) {
             let effect = match e.fault.kind {
                 FaultKind::Nak => Effect::Nak,
                 FaultKind::Corrupt { probability } => Effect::Corrupt(f64::from(probability)),
@@ -120,9 +116,20 @@ impl BusFaults {
                 fault: *e,
             };
             // Never full: the schedule holds at most as many faults in all.
-            let _ = self.faults.push(entry);
+            let _ = fresh.push(entry);
         }
-        self.seen = held;
+        if fresh != self.faults {
+            let kept = match &self.stream {
+                Some((index, ..)) => fresh
+                    .iter()
+                    .any(|e| self.faults.contains(e) && e.fault.index == *index),
+                None => false,
+            };
+            if !kept {
+                self.stream = None;
+            }
+            self.faults = fresh;
+        }
     }
 
     /// The rig's device these faults belong to.
@@ -167,12 +174,19 @@ impl BusFaults {
         }) else {
             return byte;
         };
-        if self.stream.as_ref().map(|(index, _)| *index) != Some(fault.index) {
-            self.stream = Some((fault.index, fault.rng()));
+        // A stream starts at its fault's first byte: another fault's, or an instant before the
+        // last draw (a new run of the same schedule), starts it again.
+        let fresh = match &self.stream {
+            Some((index, _, last_ns)) => *index != fault.index || t_ns < *last_ns,
+            None => true,
+        };
+        if fresh {
+            self.stream = Some((fault.index, fault.rng(), t_ns));
         }
-        let Some((_, rng)) = &mut self.stream else {
+        let Some((_, rng, last_ns)) = &mut self.stream else {
             return byte;
         };
+        *last_ns = t_ns;
         if unit_f64(rng) < probability {
             let bit = (unit_f64(rng) * 8.0) as u32; // in 0..8: the draw is below 1
             byte ^ 1u8.wrapping_shl(bit)

@@ -80,7 +80,7 @@ fn corrupt_flips_one_bit_per_hit_from_the_faults_stream() {
     let mut rng = corrupt.rng();
     let mut hits = 0;
     for i in 0..4_000u64 {
-        let t = 1_000 + i % 1_000;
+        let t = 1_000 + i / 4;
         let mut bus = faults.on(&mut fake, t);
         let got = if i % 2 == 0 {
             bus.exchange(0x00)
@@ -186,6 +186,23 @@ fn clock_stretch_is_owed_per_byte_read_on_i2c_only() {
 }
 
 #[test]
+fn a_new_run_of_the_same_schedule_draws_the_same_bits_again() {
+    let s = schedule(&[(0, 0, 1_000, FaultKind::Corrupt { probability: 0.5 })]);
+    let mut faults = BusFaults::for_device(&s, 0);
+    let mut fake = Fake::default();
+    let mut run = |faults: &mut BusFaults| {
+        (0..300)
+            .map(|t| faults.on(&mut fake, t).exchange(0))
+            .collect::<heapless::Vec<u8, 300>>()
+    };
+    let first = run(&mut faults);
+    // A new Configure with the same schedule: the same faults, time from 0 again.
+    faults.sync(&s);
+    assert_eq!(run(&mut faults), first);
+    assert_ne!(first.iter().filter(|&&b| b != BYTE).count(), 0);
+}
+
+#[test]
 fn sync_takes_new_faults_and_starts_over_after_a_clear() {
     let mut s = schedule(&[(0, 0, 10, FaultKind::Reset), (1, 0, 10, FaultKind::Nak)]);
     let mut faults = BusFaults::new(0);
@@ -198,5 +215,14 @@ fn sync_takes_new_faults_and_starts_over_after_a_clear() {
     s.clear();
     faults.sync(&s);
     assert!(faults.is_empty() && !faults.nak(5));
+    // Cleared and refilled between two syncs (Configure and AddFault in one read).
+    s.push(Fault::new(0, Window::new(20, 30), FaultKind::Nak), SEED)
+        .unwrap();
+    faults.sync(&s);
+    s.clear();
+    s.push(Fault::new(0, Window::new(40, 50), FaultKind::Nak), SEED)
+        .unwrap();
+    faults.sync(&s);
+    assert!(!faults.nak(25) && faults.nak(45));
     assert_eq!(faults.device(), 0);
 }
