@@ -142,23 +142,30 @@ impl BusFaults {
         self.faults.is_empty()
     }
 
-    fn active(&self, t_ns: u64) -> impl Iterator<Item = &Entry> {
-        self.faults.iter().filter(move |e| e.window.contains(t_ns))
+    /// What is in force at `t_ns`, in one pass over the faults.
+    fn active(&self, t_ns: u64) -> Active {
+        let mut active = Active::default();
+        for (i, e) in self.faults.iter().enumerate() {
+            if !e.window.contains(t_ns) {
+                continue;
+            }
+            match e.effect {
+                Effect::Nak => active.nak = true,
+                Effect::Corrupt(_) => active.corrupt = active.corrupt.or(Some(i)),
+                Effect::Stretch(ns) => active.stretch_ns = active.stretch_ns.saturating_add(ns),
+            }
+        }
+        active
     }
 
     /// Whether the chip refuses its bus at `t_ns` (a `nak` window).
     pub fn nak(&self, t_ns: u64) -> bool {
-        self.active(t_ns).any(|e| e.effect == Effect::Nak)
+        self.active(t_ns).nak
     }
 
     /// How long the chip stretches SCL before each byte it drives at `t_ns`.
     pub fn stretch_ns(&self, t_ns: u64) -> u32 {
-        self.active(t_ns)
-            .map(|e| match e.effect {
-                Effect::Stretch(ns) => ns,
-                _ => 0,
-            })
-            .fold(0, u32::saturating_add)
+        self.active(t_ns).stretch_ns
     }
 
     /// The stretch owed to the bus since the last call (the sum over the bytes driven).
@@ -168,10 +175,20 @@ impl BusFaults {
 
     /// `byte`, driven by the chip at `t_ns`, as the controller receives it (`corrupt`).
     pub fn drive(&mut self, t_ns: u64, byte: u8) -> u8 {
-        let Some((probability, fault)) = self.active(t_ns).find_map(|e| match e.effect {
-            Effect::Corrupt(p) => Some((p, e.fault)),
-            _ => None,
-        }) else {
+        let corrupt = self.active(t_ns).corrupt;
+        self.corrupt(corrupt, t_ns, byte)
+    }
+
+    /// `byte` through the corrupt fault at `entry` of the faults, if any.
+    fn corrupt(&mut self, entry: Option<usize>, t_ns: u64, byte: u8) -> u8 {
+        let Some((probability, fault)) =
+            entry
+                .and_then(|i| self.faults.get(i))
+                .and_then(|e| match e.effect {
+                    Effect::Corrupt(p) => Some((p, e.fault)),
+                    _ => None,
+                })
+        else {
             return byte;
         };
         // A stream starts at its fault's first byte: another fault's, or an instant before the
@@ -199,17 +216,20 @@ impl BusFaults {
     pub fn on<'a, T: ?Sized>(&'a mut self, target: &'a mut T, now_ns: u64) -> Faulted<'a, T> {
         Faulted {
             target,
+            active: self.active(now_ns),
             faults: self,
             now_ns,
         }
     }
+}
 
-    /// A byte the chip drives on I2C: stretched, then corrupted.
-    fn drive_i2c(&mut self, t_ns: u64, byte: u8) -> u8 {
-        let stretch = u64::from(self.stretch_ns(t_ns));
-        self.stretch_ns = self.stretch_ns.saturating_add(stretch);
-        self.drive(t_ns, byte)
-    }
+/// The faults in force at one instant.
+#[derive(Clone, Copy, Debug, Default)]
+struct Active {
+    nak: bool,
+    /// The corrupt fault's position among the faults.
+    corrupt: Option<usize>,
+    stretch_ns: u32,
 }
 
 /// A target seen through its device's [`BusFaults`] at one instant ([`BusFaults::on`]).
@@ -217,6 +237,17 @@ pub struct Faulted<'a, T: ?Sized> {
     target: &'a mut T,
     faults: &'a mut BusFaults,
     now_ns: u64,
+    active: Active,
+}
+
+impl<T: ?Sized> Faulted<'_, T> {
+    /// A byte the chip drives (`corrupt`).
+    fn drive(&mut self, byte: u8) -> u8 {
+        match self.active.corrupt {
+            None => byte,
+            some => self.faults.corrupt(some, self.now_ns, byte),
+        }
+    }
 }
 
 impl<T: ?Sized> Faulted<'_, T> {
@@ -233,12 +264,12 @@ impl<T: ?Sized> Faulted<'_, T> {
 
 impl<T: SpiTarget + ?Sized> SpiTarget for Faulted<'_, T> {
     fn select(&mut self) -> u8 {
-        self.faults.absent = self.faults.nak(self.now_ns);
+        self.faults.absent = self.active.nak;
         if self.faults.absent {
             return RELEASED;
         }
         let miso = self.target.select();
-        self.faults.drive(self.now_ns, miso)
+        self.drive(miso)
     }
 
     fn exchange(&mut self, mosi: u8) -> u8 {
@@ -246,7 +277,7 @@ impl<T: SpiTarget + ?Sized> SpiTarget for Faulted<'_, T> {
             return RELEASED;
         }
         let miso = self.target.exchange(mosi);
-        self.faults.drive(self.now_ns, miso)
+        self.drive(miso)
     }
 
     fn deselect(&mut self) {
@@ -258,7 +289,7 @@ impl<T: SpiTarget + ?Sized> SpiTarget for Faulted<'_, T> {
 
 impl<T: I2cTarget + ?Sized> I2cTarget for Faulted<'_, T> {
     fn start(&mut self, address: u8, read: bool) -> bool {
-        self.faults.absent = self.faults.nak(self.now_ns);
+        self.faults.absent = self.active.nak;
         !self.faults.absent && self.target.start(address, read)
     }
 
@@ -271,7 +302,10 @@ impl<T: I2cTarget + ?Sized> I2cTarget for Faulted<'_, T> {
             return RELEASED;
         }
         let byte = self.target.read();
-        self.faults.drive_i2c(self.now_ns, byte)
+        // SCL held low before the byte, then the byte driven.
+        let stretch = u64::from(self.active.stretch_ns);
+        self.faults.stretch_ns = self.faults.stretch_ns.saturating_add(stretch);
+        self.drive(byte)
     }
 
     fn stop(&mut self) {
