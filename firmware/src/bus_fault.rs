@@ -204,11 +204,28 @@ impl BusFaults {
             return byte;
         };
         *last_ns = t_ns;
-        if unit_f64(rng) < probability {
-            let bit = (unit_f64(rng) * 8.0) as u32; // in 0..8: the draw is below 1
-            byte ^ 1u8.wrapping_shl(bit)
-        } else {
-            byte
+        flip(rng, probability, byte)
+    }
+
+    /// Applies to `bytes`, the next bytes the chip will drive at `t_ns` in order, the
+    /// corruption [`BusFaults::drive`] will apply to them, without drawing: for a board that
+    /// loads its MISO stream ahead of the transaction, and then replays the transaction
+    /// through [`BusFaults::on`], which draws the same.
+    pub fn preview(&self, t_ns: u64, bytes: &mut [u8]) {
+        let Some(e) = self.active(t_ns).corrupt.and_then(|i| self.faults.get(i)) else {
+            return;
+        };
+        let Effect::Corrupt(probability) = e.effect else {
+            return;
+        };
+        let mut rng = match &self.stream {
+            Some((index, rng, last_ns)) if *index == e.fault.index && t_ns >= *last_ns => {
+                rng.clone()
+            }
+            _ => e.fault.rng(),
+        };
+        for byte in bytes {
+            *byte = flip(&mut rng, probability, *byte);
         }
     }
 
@@ -220,6 +237,16 @@ impl BusFaults {
             faults: self,
             now_ns,
         }
+    }
+}
+
+/// `byte` with one bit flipped with `probability`, by the module docs' rule.
+fn flip(rng: &mut StreamRng, probability: f64, byte: u8) -> u8 {
+    if unit_f64(rng) < probability {
+        let bit = (unit_f64(rng) * 8.0) as u32; // in 0..8: the draw is below 1
+        byte ^ 1u8.wrapping_shl(bit)
+    } else {
+        byte
     }
 }
 

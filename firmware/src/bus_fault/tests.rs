@@ -226,3 +226,25 @@ fn sync_takes_new_faults_and_starts_over_after_a_clear() {
     assert!(!faults.nak(25) && faults.nak(45));
     assert_eq!(faults.device(), 0);
 }
+
+#[test]
+fn preview_shows_the_flips_the_next_bytes_will_get() {
+    let s = schedule(&[(0, 100, 10_000, FaultKind::Corrupt { probability: 0.3 })]);
+    let mut faults = BusFaults::for_device(&s, 0);
+    let mut fake = Fake::default();
+    let mut ahead = [BYTE; 64];
+    faults.preview(50, &mut ahead);
+    assert_eq!(ahead, [BYTE; 64], "outside the window: nothing");
+    for t in [100, 200, 9_000] {
+        faults.preview(t, &mut ahead);
+        let mut bus = faults.on(&mut fake, t);
+        let mut got = [bus.select(); 64];
+        for slot in got.iter_mut().skip(1) {
+            *slot = bus.exchange(0);
+        }
+        bus.deselect();
+        assert_eq!(got, ahead, "at {t}");
+        assert_ne!(got, [BYTE; 64]);
+        ahead = [BYTE; 64];
+    }
+}
