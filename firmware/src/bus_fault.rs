@@ -19,9 +19,11 @@
 //!   the released line, [`RELEASED`]); STOP reaches it. On SPI the chip is dead for any
 //!   transaction whose chip select falls in the window: it sees nothing, drives nothing, and
 //!   MISO reads [`RELEASED`] (`0xFF`) on every byte. That is what a controller reads from an
-//!   undriven MISO on the boards margemu targets: the flight controllers' STM32 SPI
-//!   configurations (Betaflight's and ArduPilot's ChibiOS board files) put a pull-up on the MISO
-//!   pin, and the drivers' probes treat a WHO_AM_I of `0xFF` as "no chip".
+//!   undriven MISO on the flight controllers margemu targets: Betaflight configures the MISO
+//!   pin of its STM32 SPI buses with a pull-up (`SPI_IO_AF_SDI_CFG` in its STM32 platform
+//!   headers), and a released line with a pull-up reads ones; the drivers' probes then find a
+//!   WHO_AM_I of `0xFF`, no known chip. (margemu's host adapters read `0xFF` with chip select
+//!   released for the same reason.)
 //! - `corrupt { probability }`: each byte the chip drives (every MISO byte of a selection,
 //!   every byte the controller reads on I2C) inside the window has one bit flipped with that
 //!   probability. The draws come from the fault's own stream ([`ScheduledFault::rng`]), in
@@ -29,9 +31,9 @@
 //!   `v` picks the bit `floor(8 v)` (0 = LSB). The stream advances only on bytes inside its
 //!   window, so the same transactions corrupt the same bits on every run. Time moves forward
 //!   within a run: a byte at an instant before the stream's last draw (a new run of the same
-//!   schedule) starts the stream again. On SPI the driven
-//!   bytes are those the chip prepares ([`SpiTarget`]'s contract): one at select and one after
-//!   each byte clocked, the last of which the controller never clocks out; each takes its draw.
+//!   schedule) starts the stream again. On SPI the driven bytes are those the chip prepares
+//!   ([`SpiTarget`]'s contract): one at select and one after each byte clocked, the last of
+//!   which the controller never clocks out; each takes its draw.
 //! - `clock_stretch { stretch_ns }`: on I2C the chip holds SCL low `stretch_ns` before each
 //!   byte it drives (each byte the controller reads), counted in
 //!   [`BusFaults::take_stretch_ns`] for the caller to spend (a board waits that long before
