@@ -294,6 +294,34 @@ mod tests {
     }
 
     #[test]
+    fn a_dead_chip_in_a_nak_window_and_reading_after_it() {
+        use margemu_firmware::fault::FaultSchedule;
+        use margemu_model::fault::{Fault, FaultKind, Window};
+        let mut chip = Chip::new();
+        let (mut board, _) = Board::init(&mut chip, 200.0).unwrap();
+        assert!(board.read(&mut chip).unwrap().is_empty());
+        let mut schedule = FaultSchedule::new();
+        let window = Window::new(10_000_000, 20_000_000);
+        schedule
+            .push(Fault::new(0, window, FaultKind::Nak), 1)
+            .unwrap();
+        board.faults().sync(&schedule, 0);
+        let sample = PhysicalSample {
+            acc: [1.0, -2.0, 9.8],
+            ..PhysicalSample::default()
+        };
+        // Inside the window the driver reads INT_STATUS as 0xFF, FIFO_FULL set: it takes it
+        // for an overflow and flushes the FIFO, a write the dead chip never sees.
+        chip.latch_at(&sample, 10_000_000);
+        assert!(board.read(&mut chip).unwrap().is_empty());
+        assert_eq!(board.overflows(), 1);
+        // After the window both samples are read: the flush was lost.
+        chip.latch_at(&sample, 20_000_000);
+        assert_eq!(board.read(&mut chip).unwrap().len(), 2);
+        assert_eq!(board.overflows(), 1);
+    }
+
+    #[test]
     fn an_overflow_flushes_the_fifo_and_reading_resumes() {
         let mut chip = Chip::new();
         let (mut board, _) = Board::init(&mut chip, 1000.0).unwrap();
