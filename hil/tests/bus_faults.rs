@@ -8,6 +8,7 @@
 //! - `corrupt`: one bit per hit, from the fault's stream, through `SpiBus` + `ChipSelect`.
 //! - `clock_stretch`: the crate's read of six bytes advances the clock by 6 × the stretch; a
 //!   controller with a timeout fails the transaction at it; on SPI nothing happens.
+//! - On a shared `I2cBus`, a chip's faults silence or stretch that chip only.
 
 mod mag_support;
 
@@ -241,4 +242,48 @@ fn corrupt_through_spi_bus_and_chip_select_flips_the_streams_bits() {
         want,
         "after the window: exact"
     );
+}
+
+#[test]
+fn a_nak_window_on_a_shared_i2c_bus_silences_only_its_device() {
+    use embedded_hal::i2c::I2c as _;
+    use margemu_firmware::chip::Qmc5883l;
+    use margemu_hil::bus::I2cBus;
+    let ist8310 = bus::shared(Ist8310::new());
+    let qmc5883l = bus::shared(Qmc5883l::new());
+    // The IST8310 is the rig's device 1, with a nak window; the QMC5883L has no faults.
+    let (s, faults) = faults(1, &[(1_000, 2_000, FaultKind::Nak)]);
+    let wires = I2cBus::new()
+        .with_shared_faulted(ist8310.clone(), faults)
+        .with_shared(qmc5883l.clone());
+    let mut i2c = I2c::new(bus::shared(wires));
+    let mut id = [0u8; 1];
+    let mut ids = |i2c: &mut I2c<I2cBus>| {
+        let ist = i2c.write_read(0x0E, &[0x00], &mut id).map(|()| id[0]);
+        let qmc = i2c.write_read(0x0D, &[0x0D], &mut id).map(|()| id[0]);
+        (ist, qmc)
+    };
+    assert_eq!(ids(&mut i2c), (Ok(0x10), Ok(0xFF)));
+    Chip::advance(&mut *ist8310.borrow_mut(), 1_000);
+    assert_eq!(ids(&mut i2c), (Err(I2cError::AddressNack(0x0E)), Ok(0xFF)));
+    Chip::advance(&mut *ist8310.borrow_mut(), 2_000);
+    assert_eq!(ids(&mut i2c), (Ok(0x10), Ok(0xFF)));
+    // The schedule can be given again (a new Configure): same faults, same answers.
+    i2c.target().borrow_mut().sync_faults(&s);
+    assert_eq!(ids(&mut i2c), (Ok(0x10), Ok(0xFF)));
+    assert_eq!(i2c.target().borrow().stretched_ns(), 0);
+}
+
+#[test]
+fn clock_stretch_of_a_target_on_a_shared_bus_is_counted_by_the_bus() {
+    use embedded_hal::i2c::I2c as _;
+    use margemu_hil::bus::I2cBus;
+    let ist8310 = bus::shared(Ist8310::new());
+    let kind = FaultKind::ClockStretch { stretch_ns: 3_000 };
+    let (_, faults) = faults(0, &[(0, UNTIL_END, kind)]);
+    let wires = I2cBus::new().with_shared_faulted(ist8310, faults);
+    let mut i2c = I2c::new(bus::shared(wires));
+    let mut data = [0u8; 6];
+    i2c.write_read(0x0E, &[0x03], &mut data).unwrap();
+    assert_eq!(i2c.target().borrow().stretched_ns(), 6 * 3_000);
 }
