@@ -20,7 +20,8 @@
 //!
 //! **Bus faults.** Each adapter applies its device's `nak`, `corrupt` and `clock_stretch`
 //! faults when given them ([`SpiDevice::with_faults`], [`I2c::with_faults`], or later through
-//! its [`BusFaultsHandle`], e.g. [`BusFaultsHandle::sync`] from the firmware device's schedule),
+//! its [`BusFaultsHandle`], e.g. [`BusFaultsHandle::sync`] from the firmware device's schedule;
+//! on an [`I2cBus`], per chip: [`I2cBus::with_shared_faulted`]),
 //! through the firmware's own application ([`margemu_firmware::bus_fault`]), so a third-party
 //! driver on the host sees what it would see on a board; see each adapter's docs.
 //!
