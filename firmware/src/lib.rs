@@ -9,6 +9,8 @@
 //!   samples (register images, or kinematics through the shared model) swapped into the chip at
 //!   each sample instant, credits, telemetry and register writes out.
 //! - [`fault`]: the rig's fault schedule as the host sent it (`margemu_model::fault`).
+//! - [`bus_fault`]: the schedule's bus faults (NAK, corrupted bytes, clock stretching) applied
+//!   to a chip's bus target, by the boards and by the host's virtual buses alike.
 //! - [`chain_bench`]: the sampling-chain benchmark cases the host and the Cortex-M4F both run
 //!   (bit-identity and cost of `margemu_model::chain`).
 //! - [`spi_shadow`]: for boards whose SPI target cannot answer the address byte in time: the
@@ -17,6 +19,7 @@
 #![no_std]
 #![warn(missing_docs)]
 
+pub mod bus_fault;
 pub mod chain_bench;
 pub mod chip;
 pub mod fault;

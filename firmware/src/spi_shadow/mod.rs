@@ -64,11 +64,14 @@ pub mod sim;
 mod verify;
 
 #[cfg(test)]
+mod fault_tests;
+#[cfg(test)]
 mod tests;
 
 pub use serve::{serve, Capture, SpiPort};
 pub use verify::{replay, Outcome, Speculator, Stats, MAX_CONFIDENCE, SUCCESSORS, SWITCH_AFTER};
 
+use crate::bus_fault::{BusFaults, RELEASED};
 use crate::chip::Chip;
 
 /// MISO bytes the preloaded stream covers, and MOSI bytes a [`Capture`] keeps: the address
@@ -171,6 +174,24 @@ impl Shadow {
         self.dummy = chip.spi_read_dummy();
         self.stream[0] = ADDRESS_PHASE_MISO;
         chip.spi_read_burst(self.start, &mut self.stream[1..]);
+    }
+
+    /// Applies the chip's bus faults at `t_ns` (`crate::bus_fault`): in a `nak` window the
+    /// shadow is a dead chip (every byte [`RELEASED`], no write stored, so the replay through
+    /// the same faults, which keeps the chip out of the transaction, agrees with what was
+    /// served); in a `corrupt` window the stream carries the flips the faults' stream will
+    /// draw for its bytes ([`BusFaults::preview`]; the address-phase byte is the first one the
+    /// chip drives). A CPU takeover serves the registers uncorrupted: its replay then counts
+    /// as a miss. The window is the one at the capture's instant, not the transaction's.
+    pub fn apply_bus_faults(&mut self, faults: &BusFaults, t_ns: u64) {
+        if faults.nak(t_ns) {
+            self.regs = [RELEASED; 128];
+            self.rules = [WriteRule::NONE; 128];
+            self.stream = [RELEASED; STREAM_LEN];
+            self.dummy = None;
+            return;
+        }
+        faults.preview(t_ns, &mut self.stream);
     }
 
     /// The value a read of `addr` returns (7 bits of address), behind the dummy byte on chips

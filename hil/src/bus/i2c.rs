@@ -4,10 +4,25 @@
 //! the first operation; adjacent operations of the same direction run back to back; a repeated
 //! START and the address go before each change of direction; STOP ends it, also after a NACK,
 //! which aborts the rest.
+//!
+//! **Bus faults.** Given the device's faults ([`I2c::with_faults`], or later through its
+//! [`BusFaultsHandle`]), the
+//! adapter drives the target through [`margemu_firmware::bus_fault`] at the chip's scene clock
+//! ([`Chip::now_ns`]) when the transaction begins: in a `nak` window the address is not
+//! acknowledged ([`I2cError::AddressNack`]); `corrupt` flips bits of the bytes read;
+//! `clock_stretch` holds SCL low before each byte read, which advances the adapter's [`Clock`]
+//! ([`I2c::with_clock`]) by the stretch, and a controller given a timeout
+//! ([`I2c::with_timeout_ns`]) gives up once the target has held the transaction longer than
+//! that: STOP, and [`I2cError::Timeout`]. Without a timeout the controller waits as long as the
+//! target stretches (as the embedded-hal controllers of most HALs do; an SMBus controller
+//! would use 25 ms, the SMBus clock-low timeout, and a Linux or ChibiOS controller its
+//! transfer timeout).
 
-use super::Shared;
+use super::faults::BusFaultsHandle;
+use super::{Clock, Shared};
 use embedded_hal::i2c::{self, ErrorKind, NoAcknowledgeSource, Operation, SevenBitAddress};
-use margemu_firmware::chip::I2cTarget;
+use margemu_firmware::bus_fault::{BusFaults, Faulted};
+use margemu_firmware::chip::{Chip, I2cTarget};
 
 /// An I2C access that failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error, docsplay::Display)]
@@ -24,6 +39,13 @@ pub enum I2cError {
     },
     /// the target is borrowed elsewhere (re-entrant access through another handle)
     TargetBusy,
+    /// the target at {address:#04x} held SCL low for longer than the controller's timeout ({timeout_ns} ns)
+    Timeout {
+        /// The 7-bit address.
+        address: u8,
+        /// The controller's timeout, ns.
+        timeout_ns: u64,
+    },
 }
 
 impl i2c::Error for I2cError {
@@ -31,7 +53,7 @@ impl i2c::Error for I2cError {
         match self {
             Self::AddressNack(_) => ErrorKind::NoAcknowledge(NoAcknowledgeSource::Address),
             Self::DataNack { .. } => ErrorKind::NoAcknowledge(NoAcknowledgeSource::Data),
-            Self::TargetBusy => ErrorKind::Other,
+            Self::TargetBusy | Self::Timeout { .. } => ErrorKind::Other,
         }
     }
 }
@@ -42,17 +64,50 @@ impl i2c::Error for I2cError {
 /// [`I2cError::AddressNack`] without touching the bus.
 pub struct I2c<T> {
     target: Shared<T>,
+    faults: BusFaultsHandle<T>,
+    clock: Option<Clock>,
+    timeout_ns: Option<u64>,
 }
 
 impl<T> I2c<T> {
     /// A controller on `target`.
     pub fn new(target: Shared<T>) -> Self {
-        Self { target }
+        Self {
+            target,
+            faults: BusFaultsHandle::default(),
+            clock: None,
+            timeout_ns: None,
+        }
     }
 
     /// The target.
     pub fn target(&self) -> &Shared<T> {
         &self.target
+    }
+
+    /// Its bus faults (a handle that shares them).
+    pub fn faults(&self) -> BusFaultsHandle<T> {
+        self.faults.clone()
+    }
+
+    /// Makes the target's clock stretching advance `clock`.
+    pub fn with_clock(mut self, clock: Clock) -> Self {
+        self.clock = Some(clock);
+        self
+    }
+
+    /// Gives up a transaction once the target has stretched it by more than `timeout_ns`.
+    pub fn with_timeout_ns(mut self, timeout_ns: u64) -> Self {
+        self.timeout_ns = Some(timeout_ns);
+        self
+    }
+}
+
+impl<T: Chip> I2c<T> {
+    /// Drives the chip through its device's bus `faults` (module docs).
+    pub fn with_faults(self, faults: BusFaults) -> Self {
+        self.faults.set(faults);
+        self
     }
 }
 
@@ -76,33 +131,111 @@ impl<T: I2cTarget> i2c::I2c<SevenBitAddress> for I2c<T> {
             .target
             .try_borrow_mut()
             .map_err(|_| I2cError::TargetBusy)?;
-        let result = run(&mut *target, address, operations);
-        target.stop();
+        let mut waited = Waited {
+            clock: self.clock.as_ref(),
+            timeout_ns: self.timeout_ns,
+            address,
+            total_ns: 0,
+        };
+        let mut faults = self.faults.borrow().ok_or(I2cError::TargetBusy)?;
+        let mut line = match &mut *faults {
+            Some(faults) => Line::Faulted(faults.on(&mut target)),
+            None => Line::Plain(&mut *target),
+        };
+        let result = run(&mut line, address, operations, &mut waited);
+        line.target().stop();
+        result
+    }
+}
+
+/// The target as the controller drives it: as it is, or through its bus faults.
+enum Line<'a, T> {
+    Plain(&'a mut T),
+    Faulted(Faulted<'a, T>),
+}
+
+impl<T: I2cTarget> Line<'_, T> {
+    fn target(&mut self) -> &mut dyn I2cTarget {
+        match self {
+            Self::Plain(t) => *t,
+            Self::Faulted(t) => t,
+        }
+    }
+
+    /// The time the target held SCL low since the last call.
+    fn take_stretch_ns(&mut self) -> u64 {
+        match self {
+            Self::Plain(_) => 0,
+            Self::Faulted(t) => t.take_stretch_ns(),
+        }
+    }
+}
+
+/// The controller's waiting on a stretched clock, over one transaction.
+struct Waited<'a> {
+    clock: Option<&'a Clock>,
+    timeout_ns: Option<u64>,
+    address: u8,
+    total_ns: u64,
+}
+
+impl Waited<'_> {
+    /// Waits `ns` more (advancing the clock), or gives up at the timeout.
+    fn wait(&mut self, ns: u64) -> Result<(), I2cError> {
+        if ns == 0 {
+            return Ok(());
+        }
+        let total = self.total_ns.saturating_add(ns);
+        let (waited, result) = match self.timeout_ns {
+            Some(timeout_ns) if total > timeout_ns => {
+                let address = self.address;
+                (
+                    timeout_ns,
+                    Err(I2cError::Timeout {
+                        address,
+                        timeout_ns,
+                    }),
+                )
+            }
+            _ => (total, Ok(())),
+        };
+        if let Some(clock) = self.clock {
+            clock.advance_ns(waited.saturating_sub(self.total_ns));
+        }
+        self.total_ns = waited;
         result
     }
 }
 
 /// Everything between the first START and the STOP.
 fn run<T: I2cTarget>(
-    target: &mut T,
+    line: &mut Line<'_, T>,
     address: u8,
     operations: &mut [Operation<'_>],
+    waited: &mut Waited<'_>,
 ) -> Result<(), I2cError> {
     let mut reading = None;
     let mut written = 0;
     for op in operations {
         let read = matches!(op, Operation::Read(_));
         if reading != Some(read) {
-            if !target.start(address, read) {
+            if !line.target().start(address, read) {
                 return Err(I2cError::AddressNack(address));
             }
             reading = Some(read);
         }
         match op {
-            Operation::Read(words) => words.iter_mut().for_each(|w| *w = target.read()),
+            Operation::Read(words) => {
+                for word in words.iter_mut() {
+                    *word = line.target().read();
+                    // The target stretched SCL before it drove the byte.
+                    let stretch = line.take_stretch_ns();
+                    waited.wait(stretch)?;
+                }
+            }
             Operation::Write(words) => {
                 for &word in words.iter() {
-                    if !target.write(word) {
+                    if !line.target().write(word) {
                         let index = written;
                         return Err(I2cError::DataNack { address, index });
                     }

@@ -1,7 +1,9 @@
 //! Several I2C targets on one bus, seen by the controller as one target: [`I2cBus`].
 
 use super::Shared;
-use margemu_firmware::chip::I2cTarget;
+use margemu_firmware::bus_fault::BusFaults;
+use margemu_firmware::chip::{Chip, I2cTarget};
+use margemu_firmware::fault::FaultSchedule;
 
 /// Several I2C targets on one bus, seen by the controller as one [`I2cTarget`].
 ///
@@ -23,6 +25,13 @@ use margemu_firmware::chip::I2cTarget;
 /// Two targets acknowledging one address (an address conflict, such as two chips strapped
 /// alike) behave as open-drain wiring does: a byte written is ACKed if either target ACKs it,
 /// and a byte read is the AND of both targets' bytes.
+///
+/// **Bus faults.** A chip added with its device's faults ([`I2cBus::with_shared_faulted`]) takes
+/// part in every bus event through [`margemu_firmware::bus_fault`] at its scene clock, as on
+/// the [`I2c`] adapter: in a `nak` window it acknowledges nothing, `corrupt` flips bits of the
+/// bytes it drives (the AND with the other targets' bytes comes after), and `clock_stretch`
+/// adds up in [`I2cBus::stretched_ns`] (the bus has no clock of its own; the [`I2c`] adapter in
+/// front does not see it). [`I2cBus::sync_faults`] keeps them in step with a schedule.
 ///
 /// **Ownership.** A target is either owned by the bus ([`I2cBus::with`]) or shared with the test
 /// bench ([`I2cBus::with_shared`]), which keeps its own handle to latch samples or advance time
@@ -57,6 +66,7 @@ use margemu_firmware::chip::I2cTarget;
 pub struct I2cBus {
     slots: Vec<Slot>,
     missed: usize,
+    stretched_ns: u64,
 }
 
 /// One target and whether it acknowledged the latest START.
@@ -68,14 +78,39 @@ struct Slot {
 enum Target {
     Owned(Box<dyn I2cTarget>),
     Shared(Shared<dyn I2cTarget>),
+    Faulted(Shared<dyn ChipTarget>, Box<BusFaults>),
+}
+
+/// A chip's I2C target and its scene clock, for its bus faults.
+trait ChipTarget: I2cTarget {
+    fn scene_now_ns(&self) -> u64;
+}
+
+impl<T: Chip> ChipTarget for T {
+    fn scene_now_ns(&self) -> u64 {
+        self.now_ns()
+    }
 }
 
 impl Target {
-    /// Runs `event` on the target, or returns `None` if it is borrowed elsewhere.
-    fn with<R>(&mut self, event: impl FnOnce(&mut dyn I2cTarget) -> R) -> Option<R> {
+    /// Runs `event` on the target, or returns `None` if it is borrowed elsewhere; the stretch
+    /// its faults owe is added to `stretched_ns`.
+    fn with<R>(
+        &mut self,
+        stretched_ns: &mut u64,
+        event: impl FnOnce(&mut dyn I2cTarget) -> R,
+    ) -> Option<R> {
         match self {
             Self::Owned(target) => Some(event(target.as_mut())),
             Self::Shared(target) => target.try_borrow_mut().ok().map(|mut t| event(&mut *t)),
+            Self::Faulted(target, faults) => {
+                let mut chip = target.try_borrow_mut().ok()?;
+                let now = chip.scene_now_ns();
+                let mut faulted = faults.on(&mut *chip, now);
+                let answer = event(&mut faulted);
+                *stretched_ns = stretched_ns.saturating_add(faulted.take_stretch_ns());
+                Some(answer)
+            }
         }
     }
 }
@@ -95,6 +130,30 @@ impl I2cBus {
     pub fn with_shared<T: I2cTarget + 'static>(self, target: Shared<T>) -> Self {
         let target: Shared<dyn I2cTarget> = target;
         self.with_target(Target::Shared(target))
+    }
+
+    /// The bus with a shared chip `target` added, driven through its device's bus `faults`.
+    pub fn with_shared_faulted<T: Chip + 'static>(
+        self,
+        target: Shared<T>,
+        faults: BusFaults,
+    ) -> Self {
+        let target: Shared<dyn ChipTarget> = target;
+        self.with_target(Target::Faulted(target, Box::new(faults)))
+    }
+
+    /// Keeps the faults of every chip added with its faults those of its device in `schedule`.
+    pub fn sync_faults(&mut self, schedule: &FaultSchedule) {
+        for slot in &mut self.slots {
+            if let Target::Faulted(_, faults) = &mut slot.target {
+                faults.sync(schedule);
+            }
+        }
+    }
+
+    /// The time the targets' clock stretching has held SCL low so far.
+    pub fn stretched_ns(&self) -> u64 {
+        self.stretched_ns
     }
 
     fn with_target(mut self, target: Target) -> Self {
@@ -133,7 +192,7 @@ impl I2cBus {
             if !(all || slot.selected) {
                 continue;
             }
-            match slot.target.with(&mut event) {
+            match slot.target.with(&mut self.stretched_ns, &mut event) {
                 Some(answer) => answers.push((index, answer)),
                 None => self.missed += 1,
             }

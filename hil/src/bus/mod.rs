@@ -18,6 +18,13 @@
 //! - [`Delay`] and [`Clock`]: a `DelayNs` that never sleeps but, if given a clock, advances it
 //!   (drivers wait during their initialisation; the emulation decides what time means).
 //!
+//! **Bus faults.** Each adapter applies its device's `nak`, `corrupt` and `clock_stretch`
+//! faults when given them ([`SpiDevice::with_faults`], [`I2c::with_faults`], or later through
+//! its [`BusFaultsHandle`], e.g. [`BusFaultsHandle::sync`] from the firmware device's schedule;
+//! on an [`I2cBus`], per chip: [`I2cBus::with_shared_faulted`]),
+//! through the firmware's own application ([`margemu_firmware::bus_fault`]), so a third-party
+//! driver on the host sees what it would see on a board; see each adapter's docs.
+//!
 //! **MISO one byte ahead.** [`SpiTarget::select`] returns the MISO byte of the first byte and
 //! [`SpiTarget::exchange`] the MISO byte of the *next* one, exactly as a target's shift
 //! register works; the adapters keep that pending byte, so byte *i* read by the controller is
@@ -53,6 +60,7 @@
 //! [`I2cTarget`]: margemu_firmware::chip::I2cTarget
 
 mod delay;
+mod faults;
 mod i2c;
 mod i2c_bus;
 mod spi;
@@ -61,6 +69,7 @@ mod spi;
 mod fake;
 
 pub use delay::{Clock, Delay};
+pub use faults::BusFaultsHandle;
 pub use i2c::{I2c, I2cError};
 pub use i2c_bus::I2cBus;
 pub use spi::{ChipSelect, SpiBus, SpiDevice, SpiError};

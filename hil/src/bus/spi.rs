@@ -2,19 +2,29 @@
 //! [`SpiBus`] whose chip select is a separate [`ChipSelect`] pin.
 //!
 //! MOSI filler for reads is `0x00`. While chip select is released, the target sees nothing and
-//! MISO floats high, so the controller reads `0xFF` (as with a pull-up on real boards).
+//! MISO floats high, so the controller reads `0xFF` (as with a pull-up on real boards,
+//! [`RELEASED`]).
+//!
+//! **Bus faults.** Given the device's faults ([`SpiDevice::with_faults`], or later through
+//! the adapter's [`BusFaultsHandle`]), the adapters drive the target through
+//! [`margemu_firmware::bus_fault`], at the chip's scene clock ([`Chip::now_ns`]) when the
+//! transaction (or bus call) begins: a `nak` window makes the chip dead (MISO `0xFF`, the chip
+//! sees nothing), `corrupt` flips bits of MISO bytes, `clock_stretch` does nothing (SPI has no
+//! clock stretching).
 
+use super::faults::BusFaultsHandle;
 use super::{Clock, Shared};
 use embedded_hal::digital::{self, OutputPin, StatefulOutputPin};
 use embedded_hal::spi::{self, ErrorKind, Operation};
-use margemu_firmware::chip::SpiTarget;
+use margemu_firmware::bus_fault::{BusFaults, RELEASED};
+use margemu_firmware::chip::{Chip, SpiTarget};
 use std::cell::{Cell, RefMut};
 use std::rc::Rc;
 
 /// MOSI byte clocked out while the controller only reads.
 const FILLER: u8 = 0x00;
 /// MISO seen while no target drives the line.
-const FLOATING: u8 = 0xFF;
+const FLOATING: u8 = RELEASED;
 
 /// An SPI access that failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error, docsplay::Display)]
@@ -44,7 +54,7 @@ fn borrow<T>(target: &Shared<T>) -> Result<RefMut<'_, T>, SpiError> {
 
 /// One byte time: returns the MISO byte prepared before `mosi`, and keeps the one the target
 /// prepares for the next byte in `next`.
-fn shift<T: SpiTarget>(target: &mut T, next: &mut u8, mosi: u8) -> u8 {
+fn shift<T: SpiTarget + ?Sized>(target: &mut T, next: &mut u8, mosi: u8) -> u8 {
     let miso = *next;
     *next = target.exchange(mosi);
     miso
@@ -52,7 +62,7 @@ fn shift<T: SpiTarget>(target: &mut T, next: &mut u8, mosi: u8) -> u8 {
 
 /// `SpiBus::transfer` semantics: `max(read.len(), write.len())` bytes; a short `write` is padded
 /// with [`FILLER`], MISO bytes beyond `read` are dropped.
-fn transfer<T: SpiTarget>(target: &mut T, next: &mut u8, read: &mut [u8], write: &[u8]) {
+fn transfer<T: SpiTarget + ?Sized>(target: &mut T, next: &mut u8, read: &mut [u8], write: &[u8]) {
     for i in 0..read.len().max(write.len()) {
         let miso = shift(target, next, write.get(i).copied().unwrap_or(FILLER));
         if let Some(slot) = read.get_mut(i) {
@@ -61,7 +71,7 @@ fn transfer<T: SpiTarget>(target: &mut T, next: &mut u8, read: &mut [u8], write:
     }
 }
 
-fn transfer_in_place<T: SpiTarget>(target: &mut T, next: &mut u8, words: &mut [u8]) {
+fn transfer_in_place<T: SpiTarget + ?Sized>(target: &mut T, next: &mut u8, words: &mut [u8]) {
     for word in words {
         *word = shift(target, next, *word);
     }
@@ -72,6 +82,7 @@ fn transfer_in_place<T: SpiTarget>(target: &mut T, next: &mut u8, words: &mut [u
 pub struct SpiDevice<T> {
     target: Shared<T>,
     clock: Option<Clock>,
+    faults: BusFaultsHandle<T>,
 }
 
 impl<T> SpiDevice<T> {
@@ -80,6 +91,7 @@ impl<T> SpiDevice<T> {
         Self {
             target,
             clock: None,
+            faults: BusFaultsHandle::default(),
         }
     }
 
@@ -93,6 +105,28 @@ impl<T> SpiDevice<T> {
     pub fn target(&self) -> &Shared<T> {
         &self.target
     }
+
+    /// Its bus faults (a handle that shares them).
+    pub fn faults(&self) -> BusFaultsHandle<T> {
+        self.faults.clone()
+    }
+}
+
+impl<T: Chip> SpiDevice<T> {
+    /// Drives the chip through its device's bus `faults` (module docs).
+    pub fn with_faults(self, faults: BusFaults) -> Self {
+        self.faults.set(faults);
+        self
+    }
+}
+
+impl<T> SpiDevice<T> {
+    /// Applies the faults `handle` shares with another adapter on the same chip (so the two
+    /// draw from one stream, as the chip's one bus target does).
+    pub fn sharing_faults(mut self, handle: BusFaultsHandle<T>) -> Self {
+        self.faults = handle;
+        self
+    }
 }
 
 impl<T> spi::ErrorType for SpiDevice<T> {
@@ -102,24 +136,37 @@ impl<T> spi::ErrorType for SpiDevice<T> {
 impl<T: SpiTarget> spi::SpiDevice<u8> for SpiDevice<T> {
     fn transaction(&mut self, operations: &mut [Operation<'_, u8>]) -> Result<(), SpiError> {
         let mut target = borrow(&self.target)?;
-        let target = &mut *target;
-        let mut next = target.select();
-        for op in operations {
-            match op {
-                Operation::Read(words) => transfer(target, &mut next, words, &[]),
-                Operation::Write(words) => transfer(target, &mut next, &mut [], words),
-                Operation::Transfer(read, write) => transfer(target, &mut next, read, write),
-                Operation::TransferInPlace(words) => transfer_in_place(target, &mut next, words),
-                Operation::DelayNs(ns) => {
-                    if let Some(clock) = &self.clock {
-                        clock.advance_ns(u64::from(*ns));
-                    }
+        let clock = self.clock.as_ref();
+        let mut faults = self.faults.borrow().ok_or(SpiError::TargetBusy)?;
+        match &mut *faults {
+            Some(faults) => selection(&mut faults.on(&mut target), operations, clock),
+            None => selection(&mut *target, operations, clock),
+        }
+        Ok(())
+    }
+}
+
+/// One whole selection of `target`: select, the operations, deselect.
+fn selection<T: SpiTarget + ?Sized>(
+    target: &mut T,
+    operations: &mut [Operation<'_, u8>],
+    clock: Option<&Clock>,
+) {
+    let mut next = target.select();
+    for op in operations {
+        match op {
+            Operation::Read(words) => transfer(target, &mut next, words, &[]),
+            Operation::Write(words) => transfer(target, &mut next, &mut [], words),
+            Operation::Transfer(read, write) => transfer(target, &mut next, read, write),
+            Operation::TransferInPlace(words) => transfer_in_place(target, &mut next, words),
+            Operation::DelayNs(ns) => {
+                if let Some(clock) = clock {
+                    clock.advance_ns(u64::from(*ns));
                 }
             }
         }
-        target.deselect();
-        Ok(())
     }
+    target.deselect();
 }
 
 /// The selection state shared by an [`SpiBus`] and its [`ChipSelect`]: `None` while released,
@@ -131,6 +178,7 @@ type Line = Rc<Cell<Option<u8>>>;
 pub struct SpiBus<T> {
     target: Shared<T>,
     line: Line,
+    faults: BusFaultsHandle<T>,
 }
 
 /// The chip-select pin of an [`SpiBus`] (active low): `set_low` selects the target,
@@ -138,17 +186,25 @@ pub struct SpiBus<T> {
 pub struct ChipSelect<T> {
     target: Shared<T>,
     line: Line,
+    faults: BusFaultsHandle<T>,
 }
 
 impl<T> SpiBus<T> {
     /// A bus on `target` and its chip-select pin, released.
     pub fn new(target: Shared<T>) -> (Self, ChipSelect<T>) {
         let line = Line::default();
+        let faults = BusFaultsHandle::default();
         let cs = ChipSelect {
             target: target.clone(),
             line: line.clone(),
+            faults: faults.clone(),
         };
-        (Self { target, line }, cs)
+        let bus = Self {
+            target,
+            line,
+            faults,
+        };
+        (bus, cs)
     }
 
     /// The target.
@@ -156,13 +212,27 @@ impl<T> SpiBus<T> {
         &self.target
     }
 
-    /// Runs `f` with the target and its pending MISO byte while selected, or with `None`
-    /// while released (then the target sees nothing).
-    fn clocked(&mut self, f: impl FnOnce(Option<(&mut T, &mut u8)>)) -> Result<(), SpiError> {
+    /// Its bus faults, shared with its chip select (module docs).
+    pub fn faults(&self) -> BusFaultsHandle<T> {
+        self.faults.clone()
+    }
+}
+
+impl<T: SpiTarget> SpiBus<T> {
+    /// Runs `f` with the target (through its faults, if any) and its pending MISO byte while
+    /// selected, or with `None` while released (then the target sees nothing).
+    fn clocked(
+        &mut self,
+        f: impl FnOnce(Option<(&mut dyn SpiTarget, &mut u8)>),
+    ) -> Result<(), SpiError> {
         match self.line.get() {
             None => f(None),
             Some(mut next) => {
-                f(Some((&mut *borrow(&self.target)?, &mut next)));
+                let mut target = borrow(&self.target)?;
+                match &mut *self.faults.borrow().ok_or(SpiError::TargetBusy)? {
+                    Some(faults) => f(Some((&mut faults.on(&mut target), &mut next))),
+                    None => f(Some((&mut *target, &mut next))),
+                }
                 self.line.set(Some(next));
             }
         }
@@ -213,10 +283,23 @@ impl<T> digital::ErrorType for ChipSelect<T> {
     type Error = SpiError;
 }
 
+impl<T: SpiTarget> ChipSelect<T> {
+    /// Runs `f` on the target, through its faults if any.
+    fn edge<R>(&mut self, f: impl FnOnce(&mut dyn SpiTarget) -> R) -> Result<R, SpiError> {
+        let mut target = borrow(&self.target)?;
+        Ok(
+            match &mut *self.faults.borrow().ok_or(SpiError::TargetBusy)? {
+                Some(faults) => f(&mut faults.on(&mut target)),
+                None => f(&mut *target),
+            },
+        )
+    }
+}
+
 impl<T: SpiTarget> OutputPin for ChipSelect<T> {
     fn set_low(&mut self) -> Result<(), SpiError> {
         if self.line.get().is_none() {
-            let first = borrow(&self.target)?.select();
+            let first = self.edge(|t| t.select())?;
             self.line.set(Some(first));
         }
         Ok(())
@@ -224,7 +307,7 @@ impl<T: SpiTarget> OutputPin for ChipSelect<T> {
 
     fn set_high(&mut self) -> Result<(), SpiError> {
         if self.line.get().is_some() {
-            borrow(&self.target)?.deselect();
+            self.edge(|t| t.deselect())?;
             self.line.set(None);
         }
         Ok(())

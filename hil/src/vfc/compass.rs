@@ -56,7 +56,8 @@
 use super::board::on_bus;
 use crate::bus::{self, Shared};
 use embedded_hal::i2c::I2c as _;
-use margemu_firmware::chip::EmulatedChip;
+use margemu_firmware::chip::{Chip as _, EmulatedChip};
+use margemu_firmware::fault::FaultSchedule;
 use margemu_firmware::link::rig::Rig;
 use margemu_protocol::chip::{ChipModel, ChipSettings, Conversion};
 use margemu_protocol::regmap::mag_image;
@@ -131,6 +132,8 @@ pub struct Compass {
     next_poll_ns: u64,
     /// Polls that found no new measurement.
     not_ready: u64,
+    /// Polls whose transactions failed.
+    failed: u64,
 }
 
 fn read(i2c: &mut Bus, address: u8, register: u8, buf: &mut [u8]) -> Result<(), String> {
@@ -174,6 +177,7 @@ impl Compass {
             slot,
             next_poll_ns: now_ns + PERIOD_NS,
             not_ready: 0,
+            failed: 0,
         };
         let setup = compass
             .on_bus(rig, |i2c, c| match c.model {
@@ -196,17 +200,27 @@ impl Compass {
         if now_ns < self.next_poll_ns {
             return Ok(None);
         }
-        let field = self
-            .on_bus(rig, |i2c, c| match c.settings.conversion {
-                Conversion::Qmc5883l(range) => {
-                    Ok(qmc5883l_read(i2c, c.address)?.map(|raw| qmc5883l::field_ut(raw, range)))
-                }
-                Conversion::Rm3100(cycle_counts) => {
-                    Ok(rm3100_read(i2c, c.address)?.map(|raw| rm3100::field_ut(raw, cycle_counts)))
-                }
-                _ => Ok(ist8310_read(i2c, c.address)?.map(ist8310::field_ut)),
-            })
-            .map_err(|e| self.fail(&e))?;
+        let address = self.config.address;
+        if rig.i2c_target(address).is_none() {
+            return Err(self.fail(&format!("no device answers I2C address {address:#04x}")));
+        }
+        let read = self.on_bus(rig, |i2c, c| match c.settings.conversion {
+            Conversion::Qmc5883l(range) => {
+                Ok(qmc5883l_read(i2c, c.address)?.map(|raw| qmc5883l::field_ut(raw, range)))
+            }
+            Conversion::Rm3100(cycle_counts) => {
+                Ok(rm3100_read(i2c, c.address)?.map(|raw| rm3100::field_ut(raw, cycle_counts)))
+            }
+            _ => Ok(ist8310_read(i2c, c.address)?.map(ist8310::field_ut)),
+        });
+        // A failed transaction (a NACK, a corrupted status, a timeout: the bus faults) loses
+        // this poll only; the next one is a period later, as ArduPilot's and PX4's compass
+        // drivers retry at their next cycle.
+        let Ok(field) = read else {
+            self.failed += 1;
+            self.next_poll_ns = now_ns + PERIOD_NS;
+            return Ok(None);
+        };
         let Some(ut) = field else {
             self.not_ready += 1;
             return Ok(None);
@@ -215,9 +229,26 @@ impl Compass {
         Ok(Some(rotate(&self.config.to_body, ut)))
     }
 
+    /// Keeps the bus faults of its I2C bus those of the rig's device at its address in
+    /// `schedule` (none while no device answers it).
+    pub fn sync_faults(&self, rig: &Rig, schedule: &FaultSchedule) {
+        let address = Some(self.config.address);
+        let device = rig
+            .chips()
+            .position(|c| c.i2c_addresses_now().contains(&address));
+        if let Some(device) = device.and_then(|d| u8::try_from(d).ok()) {
+            self.i2c.faults().sync(schedule, device);
+        }
+    }
+
     /// Polls that found no new measurement so far.
     pub fn not_ready(&self) -> u64 {
         self.not_ready
+    }
+
+    /// Polls whose transactions failed so far (each retried a period later).
+    pub fn failed(&self) -> u64 {
+        self.failed
     }
 
     /// Runs `f` on the bus with the rig's chip at the compass's address in the slot.

@@ -90,6 +90,8 @@ pub struct FcReport {
     pub compass_readings: u64,
     /// Compass polls that found no new measurement.
     pub compass_not_ready: u64,
+    /// Compass polls whose transactions failed (a bus fault), each retried a period later.
+    pub compass_failed: u64,
     /// Set-ups done.
     pub inits: u64,
     /// Samples read from the FIFO.
@@ -217,6 +219,7 @@ impl VirtualFc {
         let Some(board) = &mut self.board else {
             return Ok(());
         };
+        board.sync_faults(device.faults());
         let chip: &mut EmulatedChip = device.chip_mut();
         if !board.data_ready(chip)? {
             return Ok(());
@@ -291,16 +294,18 @@ impl VirtualFc {
         let Some(compass) = &mut self.compass else {
             return Ok(());
         };
-        let before = compass.not_ready();
+        compass.sync_faults(device.rig(), device.faults());
+        let before = (compass.not_ready(), compass.failed());
         let reading = compass.poll(device.rig_mut(), now_ns)?;
-        let not_ready = compass.not_ready();
+        let (not_ready, failed) = (compass.not_ready(), compass.failed());
         if let Some(mag) = reading {
             self.held.push((now_ns, mag));
         }
-        if reading.is_some() || not_ready != before {
+        if reading.is_some() || (not_ready, failed) != before {
             self.update(|r| {
                 r.compass_readings += u64::from(reading.is_some());
                 r.compass_not_ready = not_ready;
+                r.compass_failed = failed;
             });
         }
         Ok(())
@@ -500,12 +505,13 @@ impl std::fmt::Display for FcReport {
         if let Some(c) = &self.compass {
             write!(
                 f,
-                "; compass {} at I2C {:#04x} (identity {:#04x}): {} readings, {} not ready",
+                "; compass {} at I2C {:#04x} (identity {:#04x}): {} readings, {} not ready, {} failed",
                 c.model.part_name(),
                 c.address,
                 c.identity,
                 self.compass_readings,
-                self.compass_not_ready
+                self.compass_not_ready,
+                self.compass_failed
             )?;
         }
         let sent: Vec<String> = self.sent.iter().map(|(m, n)| format!("{m} {n}")).collect();

@@ -20,12 +20,29 @@
 //! empty: EV3 of RM0383's slave transmitter sequence), with the buffer interrupt off, so a read
 //! never pops a FIFO byte the controller does not take. A NACK (AF) ends a read (STOPF is not
 //! set after a NACK: RM0383, I2C_SR1). Writes are taken at RXNE.
+//!
+//! **Bus faults** (`margemu_firmware::bus_fault`, one [`BusFaults`] per rig device, kept in
+//! step with the device's schedule by [`configure`]) at the chip's scene clock:
+//! - `nak`: the peripheral acknowledges its own addresses in hardware, so [`configure`] leaves
+//!   a device's addresses out of OAR1/OAR2 while its `nak` window holds the chip's time (its
+//!   START is then not acknowledged); the handlers also drive the chip through the faults, so
+//!   a START that the hardware took just before the main loop saw the window reaches nobody
+//!   and reads `0xFF`;
+//! - `corrupt`: each byte read is drawn through the faults before it goes to DR;
+//! - `clock_stretch`: the handler waits the stretch (busy, at [`crate::SYSCLK_HZ`]) before it
+//!   writes DR, and the peripheral holds SCL low meanwhile (clock stretching on). The wait
+//!   holds the main loop too (not the SPI handler): a long stretch delays the link.
 
+use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 use cortex_m::peripheral::NVIC;
+use margemu_firmware::bus_fault::BusFaults;
 use margemu_firmware::chip::{Chip, EmulatedChip, I2cTarget};
+use margemu_firmware::fault::FaultSchedule;
 use margemu_firmware::link::rig::Rig;
+use margemu_firmware::link::Device;
+use margemu_firmware::protocol::link::MAX_DEVICES;
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt, I2C1};
 use stm32f4xx_hal::rcc::{Enable, Rcc, Reset};
 
@@ -75,14 +92,30 @@ pub fn init(_i2c: I2C1, rcc: &mut Rcc, pclk1_hz: u32) {
 /// The address of the transaction in progress (its START matched it).
 static ADDRESSED: AtomicU8 = AtomicU8::new(0);
 
-/// Follows the rig's bus state: the addresses its chips answer now, the first in OAR1 and a
-/// second one in OAR2 (dual addressing on); no address acknowledged when they answer none.
-/// Called with the device locked, so no transaction is being handled.
-pub fn configure(rig: &Rig) {
+/// Each rig device's bus faults (`None` until [`configure`] first sees the device).
+struct FaultsCell(UnsafeCell<[Option<BusFaults>; MAX_DEVICES]>);
+// SAFETY: used by `configure` (the device locked: the I2C handlers masked) and by the I2C
+// handlers, which run at one priority and so never preempt each other.
+unsafe impl Sync for FaultsCell {}
+
+static FAULTS: FaultsCell = FaultsCell(UnsafeCell::new([const { None }; MAX_DEVICES]));
+
+/// Follows the rig's bus state: the addresses its chips answer now, but for those of a device
+/// in a `nak` window, the first in OAR1 and a second one in OAR2 (dual addressing on); no
+/// address acknowledged when they answer none. Keeps the devices' bus faults in step with
+/// `schedule`. Called with the device locked, so no transaction is being handled.
+pub fn configure(rig: &Rig, schedule: &FaultSchedule) {
+    // SAFETY: see `FaultsCell`: the handlers are masked while the device is locked.
+    let faults = unsafe { &mut *FAULTS.0.get() };
+    for (d, slot) in (0u8..).zip(faults.iter_mut()) {
+        slot.get_or_insert_with(|| BusFaults::new(d)).sync(schedule);
+    }
     let i2c = regs();
     let mut answered = rig
         .chips()
-        .flat_map(|c| c.i2c_addresses_now())
+        .zip(faults.iter())
+        .filter(|(c, f)| !f.as_ref().is_some_and(|f| f.nak(c.now_ns())))
+        .flat_map(|(c, _)| c.i2c_addresses_now())
         .flatten();
     let (first, second) = (answered.next(), answered.next());
     let fallback = rig.primary().i2c_address();
@@ -115,6 +148,33 @@ fn regs() -> &'static pac::i2c1::RegisterBlock {
     unsafe { &*I2C1::ptr() }
 }
 
+/// The device at `address` (by index) and its faults, from an I2C handler.
+///
+/// # Safety
+///
+/// Only from the I2C handlers (see `FaultsCell`).
+unsafe fn target(
+    device: &mut Device<{ device::RING }>,
+    address: u8,
+) -> Option<(&mut EmulatedChip, &'static mut BusFaults)> {
+    let d = device
+        .rig()
+        .chips()
+        .position(|c| c.i2c_addresses_now().contains(&Some(address)))?;
+    // SAFETY: the caller's contract.
+    let faults = unsafe { &mut *FAULTS.0.get() };
+    let faults = faults.get_mut(d)?.as_mut()?;
+    Some((device.rig_mut().chip_mut(d)?, faults))
+}
+
+/// Waits `ns` with SCL held low (the peripheral stretches until DR is written).
+fn stretch(ns: u64) {
+    if ns > 0 {
+        let cycles = ns.saturating_mul(u64::from(crate::SYSCLK_HZ / 1_000_000)) / 1_000;
+        cortex_m::asm::delay(u32::try_from(cycles).unwrap_or(u32::MAX));
+    }
+}
+
 #[interrupt]
 fn I2C1_EV() {
     let i2c = regs();
@@ -134,21 +194,27 @@ fn I2C1_EV() {
         };
         let address = (own >> 1) as u8 & 0x7F;
         ADDRESSED.store(address, Ordering::Relaxed);
-        let Some(chip) = device.rig_mut().i2c_target(address) else {
+        // SAFETY: an I2C handler.
+        let Some((chip, faults)) = (unsafe { target(device, address) }) else {
             return;
         };
+        let now = chip.now_ns();
+        let mut chip = faults.on(chip, now);
         chip.start(address, read);
         let cr2 = i2c.cr2().read().bits();
         if read {
             i2c.cr2().write(|w| unsafe { w.bits(cr2 & !CR2_ITBUFEN) });
             let byte = chip.read();
+            stretch(chip.take_stretch_ns());
             i2c.dr().write(|w| unsafe { w.bits(u16::from(byte)) });
         } else {
             i2c.cr2().write(|w| unsafe { w.bits(cr2 | CR2_ITBUFEN) });
         }
         return;
     }
-    let Some(chip) = device.rig_mut().i2c_target(ADDRESSED.load(Ordering::Relaxed)) else {
+    // SAFETY: an I2C handler.
+    let Some((chip, faults)) = (unsafe { target(device, ADDRESSED.load(Ordering::Relaxed)) })
+    else {
         // Nobody answers the address any more (a reset mid-transaction): drain, and end.
         if sr1.rx_ne().bit_is_set() {
             let _ = i2c.dr().read().bits();
@@ -158,17 +224,20 @@ fn I2C1_EV() {
         }
         return;
     };
+    let now = chip.now_ns();
+    let mut chip = faults.on(chip, now);
     if sr1.rx_ne().bit_is_set() {
         let byte = i2c.dr().read().bits() as u8;
         chip.write(byte);
     } else if sr1.tx_e().bit_is_set() && sr1.btf().bit_is_set() {
         let byte = chip.read();
+        stretch(chip.take_stretch_ns());
         i2c.dr().write(|w| unsafe { w.bits(u16::from(byte)) });
     }
     if sr1.stopf().bit_is_set() {
         // SR1 read, then a CR1 write, clears STOPF.
         i2c.cr1().modify(|r, w| unsafe { w.bits(r.bits()) });
-        end(chip);
+        end(&mut chip);
     }
 }
 
@@ -180,14 +249,17 @@ fn I2C1_ER() {
     if sr1.af().bit_is_set() {
         // SAFETY: an I2C handler at PRIORITY.
         if let Some(device) = unsafe { device::in_i2c_handler() } {
-            if let Some(chip) = device.rig_mut().i2c_target(ADDRESSED.load(Ordering::Relaxed)) {
-                end(chip);
+            // SAFETY: an I2C handler.
+            let address = ADDRESSED.load(Ordering::Relaxed);
+            if let Some((chip, faults)) = unsafe { target(device, address) } {
+                let now = chip.now_ns();
+                end(&mut faults.on(chip, now));
             }
         }
     }
 }
 
-fn end(chip: &mut EmulatedChip) {
+fn end(chip: &mut impl I2cTarget) {
     chip.stop();
     let i2c = regs();
     i2c.cr2()

@@ -10,7 +10,10 @@
 //! - the main loop: USB, the link handler ([`margemu_firmware::link::Device`]) fed and polled on
 //!   the TIM5 time base ([`clock`]), the SPI transactions replayed into the chip and judged, the
 //!   shadow refreshed with the speculator's prediction, the INT pin and the I2C addresses
-//!   updated.
+//!   updated. The chip's bus faults (`margemu_firmware::bus_fault`) apply on both buses: on
+//!   SPI to the shadow ([`Shadow::apply_bus_faults`]) and to the replay, on I2C in [`i2c`].
+//!
+//! [`Shadow::apply_bus_faults`]: margemu_firmware::spi_shadow::Shadow::apply_bus_faults
 //!
 //! Clocks: 25 MHz HSE → SYSCLK 96 MHz (the closest to the F411's 100 MHz that gives USB its
 //! 48 MHz from the same PLL), APB1 48 MHz, APB2 96 MHz. Untested on hardware; see
@@ -30,6 +33,7 @@ use core::panic::PanicInfo;
 
 use cortex_m::peripheral::SCB;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
+use margemu_firmware::bus_fault::BusFaults;
 use margemu_firmware::chip::Chip;
 use margemu_firmware::link::Identity;
 use margemu_firmware::protocol::link::{FirmwareVersion, ResetCause, DEVICE_ID_LEN};
@@ -114,6 +118,9 @@ fn main() -> ! {
     let mut spi = SpiTarget::init(dp.SPI1, dp.DMA2, &mut rcc);
     i2c::init(dp.I2C1, &mut rcc, pclk1_hz);
 
+    // Device 0's bus faults on SPI1 (the I2C target keeps its own, `i2c::configure`).
+    let spi_faults: &'static mut BusFaults =
+        cortex_m::singleton!(: BusFaults = BusFaults::new(0)).expect("made once");
     let mut speculator = Speculator::new();
     let mut stats = Stats::default();
     let mut generation = 0u32;
@@ -124,9 +131,13 @@ fn main() -> ! {
         let n = link.read(&mut rx);
         let now = clock.now_ns();
         device::lock(|device| {
+            spi_faults.sync(device.faults());
             // Transactions first: they happened before anything fed or served now.
             while let Some(capture) = spi.take() {
-                stats.record(replay(device.chip_mut(), &capture, generation));
+                let chip = device.chip_mut();
+                let at = chip.now_ns();
+                let outcome = replay(&mut spi_faults.on(chip, at), &capture, generation);
+                stats.record(outcome);
                 speculator.observe(&capture);
                 shadow_stale = true;
             }
@@ -149,12 +160,13 @@ fn main() -> ! {
                 if let Some(back) = spi.back() {
                     let chip = device.chip();
                     back.capture(chip, speculator.predict(chip.burst_start()), generation);
+                    back.apply_bus_faults(spi_faults, chip.now_ns());
                     spi.publish();
                     shadow_stale = false;
                 }
             }
             int.set(device.int_pin_at(0, now), device.chip().int_open_drain());
-            i2c::configure(device.rig());
+            i2c::configure(device.rig(), device.faults());
         });
         stats.dropped = spi.dropped();
         // SAFETY: the main loop is the only writer (see `StatsCell`).

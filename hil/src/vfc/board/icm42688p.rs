@@ -111,6 +111,8 @@ pub struct Board {
     /// The device's chip during a transaction batch; a spare part otherwise.
     slot: Shared<Chip>,
     driver: Driver,
+    /// The bus faults of the driver's SPI device.
+    faults: bus::BusFaultsHandle<Chip>,
     overflows: u64,
 }
 
@@ -151,7 +153,9 @@ impl Board {
                 rate: odr,
                 timestamps_are_absolute: false,
             };
-            let mut driver = ICM42688::new(bus::SpiDevice::new(slot.clone()))
+            let spi = bus::SpiDevice::new(slot.clone());
+            let faults = spi.faults();
+            let mut driver = ICM42688::new(spi)
                 .initialize(bus::Delay::with_clock(clock.clone()), config)
                 .map_err(|e| format!("{e:?}"))?;
             let who_am_i = driver
@@ -169,6 +173,7 @@ impl Board {
             let board = Self {
                 slot: slot.clone(),
                 driver,
+                faults,
                 overflows: 0,
             };
             Ok((board, report))
@@ -188,6 +193,7 @@ impl Board {
             slot,
             driver,
             overflows,
+            ..
         } = self;
         on_bus(slot, chip, || {
             let mut out = Vec::new();
@@ -214,6 +220,11 @@ impl Board {
                 }
             }
         })
+    }
+
+    /// The bus faults of its SPI device.
+    pub fn faults(&self) -> &bus::BusFaultsHandle<Chip> {
+        &self.faults
     }
 
     /// FIFO overflows so far.
@@ -280,6 +291,34 @@ mod tests {
         }
         assert!(board.read(&mut chip).unwrap().is_empty());
         assert_eq!(board.overflows(), 0);
+    }
+
+    #[test]
+    fn a_dead_chip_in_a_nak_window_and_reading_after_it() {
+        use margemu_firmware::fault::FaultSchedule;
+        use margemu_model::fault::{Fault, FaultKind, Window};
+        let mut chip = Chip::new();
+        let (mut board, _) = Board::init(&mut chip, 200.0).unwrap();
+        assert!(board.read(&mut chip).unwrap().is_empty());
+        let mut schedule = FaultSchedule::new();
+        let window = Window::new(10_000_000, 20_000_000);
+        schedule
+            .push(Fault::new(0, window, FaultKind::Nak), 1)
+            .unwrap();
+        board.faults().sync(&schedule, 0);
+        let sample = PhysicalSample {
+            acc: [1.0, -2.0, 9.8],
+            ..PhysicalSample::default()
+        };
+        // Inside the window the driver reads INT_STATUS as 0xFF, FIFO_FULL set: it takes it
+        // for an overflow and flushes the FIFO, a write the dead chip never sees.
+        chip.latch_at(&sample, 10_000_000);
+        assert!(board.read(&mut chip).unwrap().is_empty());
+        assert_eq!(board.overflows(), 1);
+        // After the window both samples are read: the flush was lost.
+        chip.latch_at(&sample, 20_000_000);
+        assert_eq!(board.read(&mut chip).unwrap().len(), 2);
+        assert_eq!(board.overflows(), 1);
     }
 
     #[test]

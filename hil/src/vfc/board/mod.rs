@@ -34,6 +34,7 @@ pub use mpu9250::{InitReport, BUS};
 
 use super::axes::{BodySample, MagAlignment};
 use margemu_firmware::chip::EmulatedChip;
+use margemu_firmware::fault::FaultSchedule;
 use margemu_protocol::chip::{ChipModel, ChipSettings};
 
 /// A chip the flight controller has no board (no driver) for.
@@ -177,6 +178,15 @@ impl Board {
             (Self::Mpu9250(b), EmulatedChip::Mpu6xxx(c)) => b.read(c),
             (Self::Icm42688p(b), EmulatedChip::Icm42688p(c)) => b.read(c),
             _ => Err(not_mine(self, chip)),
+        }
+    }
+
+    /// Keeps the bus faults of the board's bus those of the rig's device 0 (its chip) in
+    /// `schedule`.
+    pub fn sync_faults(&self, schedule: &FaultSchedule) {
+        match self {
+            Self::Mpu9250(b) => b.faults().sync(schedule, 0),
+            Self::Icm42688p(b) => b.faults().sync(schedule, 0),
         }
     }
 

@@ -125,21 +125,31 @@ mod wiring {
     /// The bus, as named in reports.
     pub const BUS: &str = "SPI";
 
+    /// The driver on the chip, and the bus faults of its bus.
     pub fn connect(
         chip: &Shared<Chip>,
         delay: &mut BootDelay,
         config: &mut MpuConfig<Marg>,
-    ) -> Result<Driver, String> {
+    ) -> Result<(Driver, bus::BusFaultsHandle<Chip>), String> {
         let (spi, cs) = bus::SpiBus::new(chip.clone());
-        Driver::marg(spi.reverse(), cs.reverse_cell(), delay, config).map_err(|e| format!("{e:?}"))
+        let faults = spi.faults();
+        let driver = Driver::marg(spi.reverse(), cs.reverse_cell(), delay, config)
+            .map_err(|e| format!("{e:?}"))?;
+        Ok((driver, faults))
     }
 
     /// Raw register access on the same SPI bus (for the FIFO, which the driver does not read).
     pub struct Registers(bus::SpiDevice<Chip>);
 
     impl Registers {
-        pub fn new(chip: &Shared<Chip>) -> Self {
-            Self(bus::SpiDevice::new(chip.clone()))
+        /// On the bus of the driver, sharing its `faults`.
+        pub fn new(chip: &Shared<Chip>, faults: bus::BusFaultsHandle<Chip>) -> Self {
+            Self(bus::SpiDevice::new(chip.clone()).sharing_faults(faults))
+        }
+
+        /// The bus faults.
+        pub fn faults(&self) -> bus::BusFaultsHandle<Chip> {
+            self.0.faults()
         }
 
         /// Reads `buf.len()` bytes from `addr` on (one burst; FIFO_R_W does not increment).
@@ -206,7 +216,7 @@ impl Board {
                 config.sample_rate_divisor(div);
             }
             let mut delay = BootDelay::default();
-            let mut driver = wiring::connect(&slot, &mut delay, &mut config)?;
+            let (mut driver, faults) = wiring::connect(&slot, &mut delay, &mut config)?;
             let e = |e| format!("{e:?}");
             let who_am_i = mpu9250::Mpu9250::who_am_i(&mut driver).map_err(e)?;
             let ak8963_wia = driver.ak8963_who_am_i().map_err(e)?;
@@ -220,7 +230,7 @@ impl Board {
             driver
                 .enable_interrupts(InterruptEnable::RAW_RDY_EN | InterruptEnable::FIFO_OVERFLOW_EN)
                 .map_err(e)?;
-            let mut regs = Registers::new(&slot);
+            let mut regs = Registers::new(&slot, faults);
             let user_ctrl = fifo_setup(&mut regs)?;
             let conversion = ImageConfig {
                 asa: driver.raw_mag_sensitivity_adjustments(),
@@ -286,6 +296,11 @@ impl Board {
                 .map(|r| reading(r, conversion))
                 .collect())
         })
+    }
+
+    /// The bus faults of its SPI bus (the driver's and the FIFO reads').
+    pub fn faults(&self) -> bus::BusFaultsHandle<Chip> {
+        self.regs.faults()
     }
 
     /// FIFO overflows so far (each one reset the FIFO).

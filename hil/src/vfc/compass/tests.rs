@@ -129,6 +129,36 @@ fn the_ist8310_is_set_up_like_ardupilot_does_and_read_every_10_ms() {
 }
 
 #[test]
+fn a_nak_window_loses_the_polls_inside_it_and_reading_resumes_after() {
+    use margemu_firmware::fault::FaultSchedule;
+    use margemu_model::fault::{Fault, FaultKind, Window};
+    let chip = setup(
+        ChipModel::Ist8310,
+        ChipSettings::power_on(ChipModel::Ist8310),
+        None,
+    );
+    let mut rig = rig(Some(&chip));
+    let (mut compass, _) = Compass::init(&mut rig, &config(&chip, None), 0).unwrap();
+    // The compass is the rig's device 1; its polls at 20 and 30 ms fall in the window.
+    let mut schedule = FaultSchedule::new();
+    let window = Window::new(20_000_000, 40_000_000);
+    schedule
+        .push(Fault::new(1, window, FaultKind::Nak), 9)
+        .unwrap();
+    schedule
+        .push(Fault::new(0, Window::new(0, 90_000_000), FaultKind::Nak), 9)
+        .unwrap();
+    compass.sync_faults(&rig, &schedule);
+    let mut got = Vec::new();
+    for ms in (10..=50).step_by(10) {
+        latch(&mut rig, &chip, ms - 9, ms);
+        got.push(compass.poll(&mut rig, ms * 1_000_000).unwrap().is_some());
+    }
+    assert_eq!(got, [true, false, false, true, true]);
+    assert_eq!((compass.failed(), compass.not_ready()), (2, 0));
+}
+
+#[test]
 fn a_poll_before_the_measurement_completes_waits_for_drdy() {
     let chip = setup(
         ChipModel::Ist8310,
