@@ -495,8 +495,8 @@ impl SensorFaults {
                     }
                 }
                 FaultKind::MagSaturation { field } => {
-                    for i in 0..3 {
-                        sample.mag[i] += field[i];
+                    for (m, f) in sample.mag.iter_mut().zip(field) {
+                        *m += f;
                     }
                 }
                 FaultKind::Stuck { sensor } => stuck[sensor as usize] = true,
