@@ -126,3 +126,51 @@ fn noise_and_spikes_are_seeded() {
     assert!((2..=25).contains(&spiked), "{spiked}");
     assert_eq!(csv(&got), csv(&with_fault(spikes)));
 }
+
+fn run_dir(tag: &str, text: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("margemu-faults-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let scene = Scene::parse_str(text, Path::new("faults.toml")).unwrap();
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    margemu_sim::run::simulate_to_dir(&scene, &dir, &stop, |_, _| {}).unwrap();
+    dir
+}
+
+#[test]
+fn simulate_lists_the_fault_windows_in_events_csv() {
+    use margemu_sim::fault_log::{read_rows, FaultRow, EVENTS_FILE};
+    let text = format!(
+        "{BASE}[[fault]]\nkind = \"stuck\"\nsensor = \"gyro\"\nstart = 0.25\nduration = 0.25\n\
+         [[fault]]\nkind = \"reset\"\nstart = 0.5\nuntil_end = true\n"
+    );
+    let dir = run_dir("events", &text);
+    let events = std::fs::read_to_string(dir.join(EVENTS_FILE)).unwrap();
+    assert!(
+        events.starts_with("host_ns,event,detail\n0,fault,device=mpu9250;kind=stuck;"),
+        "{events}"
+    );
+    assert_eq!(
+        read_rows(&events).unwrap(),
+        [
+            FaultRow {
+                device: "mpu9250".into(),
+                kind: "stuck".into(),
+                sensor: Some(margemu_model::fault::Sensor::Gyr),
+                start_ns: 250_000_000,
+                end_ns: Some(500_000_000),
+            },
+            FaultRow {
+                device: "mpu9250".into(),
+                kind: "reset".into(),
+                sensor: None,
+                start_ns: 500_000_000,
+                end_ns: None,
+            },
+        ]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    // A scene without faults: no events.csv, the run directory as before.
+    let clean = run_dir("clean", BASE);
+    assert!(!clean.join(EVENTS_FILE).exists());
+    let _ = std::fs::remove_dir_all(&clean);
+}
