@@ -79,6 +79,7 @@ fn evaluate_reports_the_error_inside_a_gyro_stuck_window_and_the_recovery() {
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
     assert!(report.contains("## Fault windows"), "{report}");
     let csv = std::fs::read_to_string(dir.join("faults.csv")).unwrap();
+    eprintln!("{csv}");
     assert!(
         csv.lines()
             .nth(1)
