@@ -180,7 +180,7 @@ impl FaultScorer {
                 max_inside: (w.inside.1 > 0).then_some(w.inside.2),
                 threshold: w.threshold,
                 recovery_s: match (w.recovered_at, w.row.end_ns) {
-                    (Some(t), Some(end)) => Some(t.saturating_sub(end) as f64 * 1e-9),
+                    (Some(t), Some(end)) => Some(secs(t.saturating_sub(end))),
                     _ => None,
                 },
                 window: w.row,
@@ -190,7 +190,7 @@ impl FaultScorer {
 }
 
 fn secs(ns: u64) -> f64 {
-    ns as f64 * 1e-9
+    ns as f64 / 1e9
 }
 
 fn opt(v: Option<f64>) -> String {

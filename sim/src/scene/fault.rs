@@ -204,7 +204,7 @@ fn describe(f: &Fault, i: usize, devices: &[Device]) -> String {
         .kind
         .sensor()
         .map_or(String::new(), |s| format!(" {}", s.name()));
-    let secs = |ns: u64| ns as f64 * 1e-9;
+    let secs = |ns: u64| ns as f64 / 1e9;
     let end = if f.window.end_ns == UNTIL_END {
         "the end".to_owned()
     } else {
@@ -282,7 +282,7 @@ fn resolve_one(
 
 fn window(i: usize, spec: &FaultSpec, duration_ns: Nanos) -> Result<Window, Violation> {
     let at = |key: &str, why: String| Violation::at_path(path(i, key), why);
-    let run_s = duration_ns as f64 * 1e-9;
+    let run_s = duration_ns as f64 / 1e9;
     let start_ns = match nanos_from_seconds(spec.start) {
         Some(ns) if spec.start.is_finite() && ns < duration_ns => ns,
         _ => {
