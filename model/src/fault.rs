@@ -578,7 +578,9 @@ mod tests {
                 sensor: Sensor::Gyr,
                 std: [1.0; 3],
             },
-            FaultKind::Dropout { sensor: Sensor::Mag },
+            FaultKind::Dropout {
+                sensor: Sensor::Mag,
+            },
         ];
         for k in kinds {
             f.push(&Fault::new(0, Window::new(100, 200), k)).unwrap();
@@ -598,10 +600,24 @@ mod tests {
     fn composition_order_is_scale_bias_then_replacement() {
         let mut f = SensorFaults::new(1, 1000.0);
         let w = Window::new(0, UNTIL_END);
-        f.push(&Fault::new(0, w, FaultKind::BiasStep { sensor: Sensor::Gyr, bias: [1.0; 3] }))
-            .unwrap();
-        f.push(&Fault::new(0, w, FaultKind::Scale { sensor: Sensor::Gyr, factor: [2.0; 3] }))
-            .unwrap();
+        f.push(&Fault::new(
+            0,
+            w,
+            FaultKind::BiasStep {
+                sensor: Sensor::Gyr,
+                bias: [1.0; 3],
+            },
+        ))
+        .unwrap();
+        f.push(&Fault::new(
+            0,
+            w,
+            FaultKind::Scale {
+                sensor: Sensor::Gyr,
+                factor: [2.0; 3],
+            },
+        ))
+        .unwrap();
         let mut s = sample(3.0);
         f.apply(0, &mut s);
         // In schedule order: bias first (pushed first), then scale.
@@ -609,7 +625,10 @@ mod tests {
         f.push(&Fault::new(
             0,
             w,
-            FaultKind::StuckAt { sensor: Sensor::Gyr, value: [0.5; 3] },
+            FaultKind::StuckAt {
+                sensor: Sensor::Gyr,
+                value: [0.5; 3],
+            },
         ))
         .unwrap();
         let mut s = sample(3.0);
@@ -620,8 +639,14 @@ mod tests {
     #[test]
     fn stuck_holds_the_value_before_the_window_and_releases_after() {
         let mut f = SensorFaults::new(1, 1000.0);
-        f.push(&Fault::new(0, Window::new(10, 20), FaultKind::Stuck { sensor: Sensor::Acc }))
-            .unwrap();
+        f.push(&Fault::new(
+            0,
+            Window::new(10, 20),
+            FaultKind::Stuck {
+                sensor: Sensor::Acc,
+            },
+        ))
+        .unwrap();
         let mut s = sample(1.0);
         f.apply(5, &mut s);
         for t in [10, 15, 19] {
@@ -641,7 +666,12 @@ mod tests {
         f.push(&Fault::new(
             0,
             Window::new(0, UNTIL_END),
-            FaultKind::Spikes { sensor: Sensor::Gyr, rate_hz: 10.0, amplitude: 5.0, axes: 0b100 },
+            FaultKind::Spikes {
+                sensor: Sensor::Gyr,
+                rate_hz: 10.0,
+                amplitude: 5.0,
+                axes: 0b100,
+            },
         ))
         .unwrap();
         let mut spikes = 0;
@@ -662,12 +692,37 @@ mod tests {
     fn exclusive_overlaps() {
         let w = |a, b| Window::new(a, b);
         let stuck = |d, s, win| Fault::new(d, win, FaultKind::Stuck { sensor: s });
-        let drop = Fault::new(0, w(5, 15), FaultKind::Dropout { sensor: Sensor::Gyr });
-        assert!(overlaps_exclusively(&stuck(0, Sensor::Gyr, w(0, 10)), &drop));
-        assert!(!overlaps_exclusively(&stuck(0, Sensor::Acc, w(0, 10)), &drop));
-        assert!(!overlaps_exclusively(&stuck(1, Sensor::Gyr, w(0, 10)), &drop));
-        assert!(!overlaps_exclusively(&stuck(0, Sensor::Gyr, w(0, 5)), &drop));
-        let bias = Fault::new(0, w(0, 10), FaultKind::BiasStep { sensor: Sensor::Gyr, bias: [0.0; 3] });
+        let drop = Fault::new(
+            0,
+            w(5, 15),
+            FaultKind::Dropout {
+                sensor: Sensor::Gyr,
+            },
+        );
+        assert!(overlaps_exclusively(
+            &stuck(0, Sensor::Gyr, w(0, 10)),
+            &drop
+        ));
+        assert!(!overlaps_exclusively(
+            &stuck(0, Sensor::Acc, w(0, 10)),
+            &drop
+        ));
+        assert!(!overlaps_exclusively(
+            &stuck(1, Sensor::Gyr, w(0, 10)),
+            &drop
+        ));
+        assert!(!overlaps_exclusively(
+            &stuck(0, Sensor::Gyr, w(0, 5)),
+            &drop
+        ));
+        let bias = Fault::new(
+            0,
+            w(0, 10),
+            FaultKind::BiasStep {
+                sensor: Sensor::Gyr,
+                bias: [0.0; 3],
+            },
+        );
         assert!(!overlaps_exclusively(&bias, &bias));
         let reset = Fault::new(0, w(0, 10), FaultKind::Reset);
         assert!(overlaps_exclusively(&reset, &reset));
