@@ -11,9 +11,11 @@
 //!   is not correct" flag (AK8963 datasheet §6.4.3.6 magnetic sensor overflow, §8.3.5 ST2),
 //!   which drivers check before they use the data; the data registers keep the measurement.
 //! - **ICM-42688-P**: −32768 in ACCEL_DATA / GYRO_DATA and −524288 in the 20-bit FIFO fields
-//!   (DS-000347 §6.1 FIFO packet structure and the data-register descriptions: −32768 marks
-//!   an invalid 16-bit sample, the most negative 20-bit code an invalid 20-bit one;
-//!   [`crate::regmap::icm42688p::convert::INVALID16`], `INVALID20`).
+//!   (DS-000347 §4.11 Sensor Data Registers, and the FIFO packet structure in §6: −32768 marks
+//!   an invalid 16-bit sample, as the data registers of a sensor that is off read — TDK's
+//!   forum thread "42688P sensor register data always 0x8000" shows the same — and the most
+//!   negative 20-bit code an invalid 20-bit one; [`crate::regmap::icm42688p::convert::INVALID16`],
+//!   `INVALID20`).
 //! - **BMI270, BMI088**: their datasheets define an invalid code for the temperature only
 //!   (BMI270 TEMPERATURE 0x8000, BMI088 TEMP_MSB 0x80); for accel and gyro data they define
 //!   none (a driver sees missing data through the DRDY bits, which the chip computes). margemu
