@@ -28,5 +28,6 @@ pub mod demo;
 pub mod own_files;
 pub mod perf;
 pub mod perf_chain;
+pub mod perf_faults;
 pub mod perf_mcap;
 pub mod vfc_score;

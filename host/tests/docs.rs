@@ -280,7 +280,7 @@ fn every_page_of_the_guide_is_in_the_summary() {
 
 /// Tables a scene has at its top level: a TOML block whose first header is one of these is a
 /// scene fragment.
-const SCENE_TABLES: [&str; 10] = [
+const SCENE_TABLES: [&str; 11] = [
     "integrator",
     "field",
     "bench",
@@ -291,6 +291,7 @@ const SCENE_TABLES: [&str; 10] = [
     "chip",
     "device",
     "vibration",
+    "fault",
 ];
 
 /// A TOML block as scene text, or `None` when it is not a scene example (see the module docs).

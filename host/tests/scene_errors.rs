@@ -579,3 +579,25 @@ fn filters_left_out_take_the_defaults() {
         None
     );
 }
+
+#[test]
+fn bad_fault_schedules() {
+    let stuck = "[[fault]]\nkind = \"stuck\"\nsensor = \"gyro\"\nstart = 0.2\nduration = 0.5\n";
+    assert_error(
+        &format!("{BASE}{stuck}[[fault]]\nkind = \"dropout\"\nsensor = \"gyro\"\nstart = 0.5\nduration = 0.1\n"),
+        "12:9",
+        "`fault[1].start`: fault[1] (dropout gyro on `mpu9250`, 0.5 s to 0.6 s) overlaps fault[0] (stuck gyro on `mpu9250`, 0.2 s to 0.7 s)",
+    );
+    assert_error(
+        &format!(
+            "{BASE}[[fault]]\ndevice = \"baro\"\nkind = \"nak\"\nstart = 0.2\nduration = 0.1\n"
+        ),
+        "5:10",
+        "`fault[0].device`: no device `baro`; the devices are mpu9250",
+    );
+    assert_error(
+        &format!("{BASE}[[fault]]\nkind = \"nak\"\nstart = 0.2\nduration = -0.1\n"),
+        "7:12",
+        "`fault[0].duration`: must be finite and > 0",
+    );
+}

@@ -398,6 +398,11 @@ pub struct SensorFaults {
     /// The last output per sensor before a stuck window began (what the sensor holds).
     last: Sample,
     held: [Option<Vec3>; 3],
+    /// No sensor fault is active in `[idle_from, idle_until)` (from the instant of the last full
+    /// pass that found none active to the next window's start): [`SensorFaults::apply`] only
+    /// records the sample there.
+    idle_from: u64,
+    idle_until: u64,
 }
 
 impl SensorFaults {
@@ -415,6 +420,8 @@ impl SensorFaults {
                 mag: [0.0; 3],
             },
             held: [None; 3],
+            idle_from: 0,
+            idle_until: 0,
         }
     }
 
@@ -432,6 +439,7 @@ impl SensorFaults {
             }
             _ => 0.0,
         };
+        self.idle_until = 0;
         self.faults
             .push((*fault, rng, p_spike))
             .map_err(|_| ScheduleFull)
@@ -449,6 +457,30 @@ impl SensorFaults {
     /// ([`Sensor::bit`]s whose registers must hold the chip's invalid value). Call it once per
     /// output sample, in time order.
     pub fn apply(&mut self, t_ns: u64, sample: &mut Sample) -> u8 {
+        if self.idle_from <= t_ns && t_ns < self.idle_until {
+            self.last = *sample;
+            return 0;
+        }
+        let mut active = false;
+        let mut next_start = u64::MAX;
+        for (fault, _, _) in &self.faults {
+            if fault.kind.class() != FaultClass::Sensor {
+                continue;
+            }
+            if fault.window.contains(t_ns) {
+                active = true;
+                break;
+            }
+            if fault.window.start_ns > t_ns {
+                next_start = next_start.min(fault.window.start_ns);
+            }
+        }
+        if !active {
+            (self.idle_from, self.idle_until) = (t_ns, next_start);
+            self.held = [None; 3];
+            self.last = *sample;
+            return 0;
+        }
         let mut dropout = 0u8;
         let mut replaced = [None::<Vec3>; 3];
         let mut stuck = [false; 3];

@@ -15,6 +15,7 @@
 //! - [`guard`]: the run stops at the first truth or sample value that is not finite;
 //! - [`run`] and [`output`]: the sample loop and the run directory (`truth.csv`, `marg.csv`);
 //! - [`meta`]: the schema of `meta.toml`, written and read by the same types;
+//! - [`fault_log`]: the fault windows' rows of `events.csv`, written and read by one format;
 //! - [`rundir`]: which directory a run writes to, and the completion record written last;
 //! - [`frame`]: named world frames (NWU, ENU, NED/FRD) and the one NED map;
 //! - [`quat`]: attitude quaternions as the logs and scores use them (normalisation, Euler
@@ -26,6 +27,7 @@
 pub mod bench;
 pub mod csv_column;
 pub mod csv_table;
+pub mod fault_log;
 pub mod filter_params;
 pub mod frame;
 pub mod guard;

@@ -7,8 +7,15 @@
 //! the chip's filters: [`crate::sampling`]), and the sensor model of eq. 18 turns that into
 //! accelerometer, gyroscope and magnetometer readings.
 //!
+//! The scene's sensor faults of the device (`[[fault]]`, [`margemu_model::fault::SensorFaults`]
+//! on the device's seed at the scene's output rate) act on each sample last, after the model and
+//! before anything else uses it (the chip's conversion, the files, the filters); a scene without
+//! sensor faults skips them. A dropout keeps the model's value in [`MargSample::sample`] and
+//! names the sensor in [`MargSample::dropout`]: the chip's conversion marks those registers
+//! invalid, and `marg.csv` writes `NaN` for them.
+//!
 //! `marg.csv`: `t_ns,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z` in m/s², rad/s and
-//! the scene's field unit. `perturbation.csv`: `t_ns,mag_x,mag_y,mag_z`, the disturbance added
+//! the scene's field unit (`NaN` for a sensor in a dropout window). `perturbation.csv`: `t_ns,mag_x,mag_y,mag_z`, the disturbance added
 //! to the true field per axis (written only when the scene has a `[perturbation]`).
 
 use crate::sampling::HostFront;
@@ -16,6 +23,7 @@ use crate::scene::chip::ChipSetup;
 use crate::scene::vibration::DeviceVibration;
 use crate::scene::Scene;
 use crate::truth::Truth;
+use margemu_model::fault::{Sensor, SensorFaults};
 use margemu_model::perturbation::{Complex, Perturbation, PerturbationPlan};
 use margemu_model::sensor::{self, Marg, Sample};
 use std::io::{self, Write};
@@ -51,6 +59,8 @@ pub struct MargSim {
     perturbation: Option<HostPerturbation>,
     temperature: Option<[f64; 2]>,
     chain: Option<HostFront>,
+    /// The device's sensor faults; `None` when it has none (nothing to pay).
+    faults: Option<SensorFaults>,
 }
 
 /// Front-end clipping so far: internal samples (or output samples, on the output path) that
@@ -72,6 +82,9 @@ pub struct MargSample {
     pub sample: Sample,
     /// Disturbance added to the true field.
     pub disturbance: [f32; 3],
+    /// Sensors in a dropout window ([`Sensor::bit`]s): their registers hold the chip's invalid
+    /// value ([`margemu_protocol::chip::ChipSettings::mark_invalid`]), `marg.csv` writes `NaN`.
+    pub dropout: u8,
 }
 
 impl MargSample {
@@ -80,6 +93,21 @@ impl MargSample {
     pub fn values(&self) -> impl Iterator<Item = &f32> {
         let s = &self.sample;
         s.acc.iter().chain(&s.gyr).chain(&s.mag)
+    }
+
+    /// [`Self::values`] with `NaN` for the sensors in [`Self::dropout`]: `marg.csv`'s row.
+    pub fn written_values(&self) -> [f32; 9] {
+        let mut out = [0.0f32; 9];
+        for (o, v) in out.iter_mut().zip(self.values()) {
+            *o = *v;
+        }
+        for sensor in Sensor::ALL {
+            if self.dropout & sensor.bit() != 0 {
+                let at = 3 * sensor as usize;
+                out[at..at + 3].fill(f32::NAN);
+            }
+        }
+        out
     }
 }
 
@@ -93,7 +121,7 @@ impl MargSim {
         let vibration = crate::sampling::in_plate_axes(&vibration, &scene.chip);
         let chip = (!vibration.is_empty() || crate::sampling::forces_internal_path(scene))
             .then_some((&scene.chip, &vibration));
-        Self::build(scene, &scene.spec.sensors.config(), scene.spec.seed, chip)
+        Self::build(scene, &scene.spec.sensors.config(), 0, chip)
     }
 
     /// The model of device `index` of `scene`'s rig ([`Scene::devices`]): the scene's sensor
@@ -114,17 +142,19 @@ impl MargSim {
         Some(Self::build(
             scene,
             &config,
-            device_seed(scene.spec.seed, index),
+            index,
             Some((&device.chip, &vibration)),
         ))
     }
 
+    /// The model of device `index` ([`device_seed`], its sensor faults).
     fn build(
         scene: &Scene,
         config: &sensor::MargConfig,
-        seed: u64,
+        index: usize,
         front: Option<(&ChipSetup, &DeviceVibration)>,
     ) -> Result<Self, margemu_model::Error> {
+        let seed = device_seed(scene.spec.seed, index);
         let chain = front
             .and_then(|(chip, vibration)| crate::sampling::build(scene, chip, vibration, seed))
             .transpose()?;
@@ -146,6 +176,7 @@ impl MargSim {
             perturbation,
             temperature: spec.sensors.temperature,
             chain,
+            faults: sensor_faults(scene, index, seed, rate),
         })
     }
 
@@ -202,12 +233,33 @@ impl MargSim {
             Some(chain) => chain.sample(&mut self.marg, t.t_ns, &truth),
             None => self.marg.sample(&truth),
         };
+        let mut sample = sample;
+        let dropout = match self.faults.as_mut() {
+            Some(faults) => faults.apply(t.t_ns, &mut sample),
+            None => 0,
+        };
         MargSample {
             t_ns: t.t_ns,
             sample,
             disturbance,
+            dropout,
         }
     }
+}
+
+/// The sensor faults of device `index` of `scene` (seed `seed`, output rate `rate_hz`), each
+/// at its index among the device's faults; `None` when it has no sensor fault.
+pub fn sensor_faults(scene: &Scene, index: usize, seed: u64, rate_hz: f64) -> Option<SensorFaults> {
+    let mut faults = SensorFaults::new(seed, rate_hz);
+    for fault in scene
+        .faults
+        .iter()
+        .filter(|f| usize::from(f.device) == index)
+    {
+        // The scene check keeps a schedule within MAX_FAULTS.
+        faults.push(fault).ok()?;
+    }
+    (!faults.is_empty()).then_some(faults)
 }
 
 /// Writes `marg.csv` rows (and optionally `perturbation.csv` rows).
@@ -233,7 +285,16 @@ impl<W: Write> MargWriter<W> {
 
     /// Writes one sample.
     pub fn write(&mut self, s: &MargSample) -> io::Result<()> {
-        write_row(&mut self.marg, &mut self.float, s.t_ns, s.values())?;
+        if s.dropout == 0 {
+            write_row(&mut self.marg, &mut self.float, s.t_ns, s.values())?;
+        } else {
+            write_row(
+                &mut self.marg,
+                &mut self.float,
+                s.t_ns,
+                s.written_values().iter(),
+            )?;
+        }
         if let Some(p) = self.perturbation.as_mut() {
             write_row(p, &mut self.float, s.t_ns, s.disturbance.iter())?;
         }

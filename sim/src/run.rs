@@ -149,6 +149,8 @@ pub fn simulate_to_dir_with(
 ) -> Result<RunSummary, RunError> {
     std::fs::create_dir_all(dir).map_err(write_err(dir))?;
     crate::meta::write(dir, &metadata(scene)).map_err(write_err(&dir.join(rundir::META_FILE)))?;
+    crate::fault_log::write_run_events(dir, scene)
+        .map_err(write_err(&dir.join(crate::fault_log::EVENTS_FILE)))?;
     let mut written = 0;
     let outcome = write_files(scene, dir, stop, &mut written, progress, outputs);
     let (status, ended) = match &outcome {

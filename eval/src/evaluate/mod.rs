@@ -8,6 +8,7 @@
 //!   [`Estimates`] to score many estimates against one truth (a tuner); [`stats`]: the summary;
 //! - [`align`]: the device's latency (geodesic error minimised over lags, refined below one
 //!   sample) and its clock's offset and drift (least squares on device against host time);
+//! - [`faults`]: the error inside each fault window of the scene and the time to recover;
 //! - [`phase`]: the phase rules; [`signals`]: their magnitudes from measured signals;
 //! - [`input`] and [`device_log`]: the files (`truth.csv`, `dut_attitude.csv`, estimates,
 //!   external recordings, `meta.toml`, `sent.csv`), every bad value located;
@@ -23,6 +24,7 @@
 
 pub mod align;
 pub mod device_log;
+pub mod faults;
 pub mod input;
 mod load;
 pub mod phase;

@@ -1,5 +1,6 @@
 //! The evaluation as text: a summary for the terminal, `report.md` (the tables, the alignment,
-//! the rules, the figures linked) and `errors.csv` (every scored instant).
+//! the rules, the figures linked), `errors.csv` (every scored instant) and, for a scene with
+//! faults, `faults.csv` ([`super::faults`]).
 //!
 //! The score table follows the paper's Table 3: rows `F`, `MSE` and `STD` per angle (rad², rad),
 //! then the geodesic RMS and maximum, then BROAD's heading and inclination errors (RMS and
@@ -118,6 +119,9 @@ pub fn summary(eval: &Evaluation) -> String {
     for note in &eval.notes {
         let _ = writeln!(out, "note: {note}");
     }
+    for line in super::faults::lines(&eval.faults) {
+        let _ = writeln!(out, "{line}");
+    }
     let (header, rows) = table(eval);
     let _ = write!(out, "{:<22}", "");
     for h in &header {
@@ -164,6 +168,26 @@ pub fn markdown(eval: &Evaluation, dir: &Path, figures: &[PathBuf]) -> String {
         let cells: Vec<String> = values.iter().map(|v| cell(&name, *v)).collect();
         let _ = writeln!(md, "| {name} | {} |", cells.join(" | "));
     }
+    if !eval.faults.is_empty() {
+        let o = &eval.options.faults;
+        let threshold = match o.threshold_rad {
+            Some(t) => format!("{:.3}°", t.to_degrees()),
+            None => format!(
+                "{} × the geodesic RMS before the window, at least {:.3}°",
+                o.factor,
+                o.floor_rad.to_degrees()
+            ),
+        };
+        let _ = writeln!(
+            md,
+            "\n## Fault windows\n\nFrom `events.csv`, per window: the geodesic error before it, inside it, and the time to \
+             recover after its end (the error below {threshold} for {:.3} s of scored instants). Every window in `faults.csv`.\n",
+            o.hold_ns as f64 * 1e-9
+        );
+        for line in super::faults::lines(&eval.faults) {
+            let _ = writeln!(md, "- {line}");
+        }
+    }
     let r = &eval.options.rules;
     let _ = writeln!(
         md,
@@ -192,8 +216,9 @@ pub fn markdown(eval: &Evaluation, dir: &Path, figures: &[PathBuf]) -> String {
 }
 
 /// Every file [`write()`] and [`evaluate_writing`](super::run::evaluate_writing) may write.
-pub const FILES: [&str; 6] = [
+pub const FILES: [&str; 7] = [
     "errors.csv",
+    super::faults::FAULTS_FILE,
     "report.md",
     "attitude.png",
     "attitude.svg",
@@ -276,6 +301,11 @@ pub fn write(eval: &Evaluation, dir: &Path, plots: bool) -> Result<Vec<PathBuf>,
     } else {
         Vec::new()
     };
+    if !eval.faults.is_empty() {
+        let path = dir.join(super::faults::FAULTS_FILE);
+        std::fs::write(&path, super::faults::csv(&eval.faults)).map_err(write_err(&path))?;
+        written.push(path);
+    }
     let report = dir.join("report.md");
     std::fs::write(&report, markdown(eval, dir, &figures)).map_err(write_err(&report))?;
     written.extend(figures);

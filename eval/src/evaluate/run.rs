@@ -2,10 +2,12 @@
 //! them overall and per phase in one pass that writes `errors.csv` row by row, and keeps what
 //! the report and the figures need (statistics gathered online, traces thinned), so memory
 //! does not grow with the length of the run. The arithmetic is that of the in-process scoring
-//! functions ([`score`](mod@super::score)).
+//! functions ([`score`](mod@super::score)). The same pass scores each fault window of the
+//! directory's `events.csv` ([`super::faults`]).
 
 use super::align::{latency_of_series, ClockFit, Latency, LatencySearch};
 use super::device_log::SessionFileError;
+use super::faults::FaultScorer;
 use super::load::Loaded;
 use super::phase::{Phase, PhaseRules};
 use super::quat::euler;
@@ -88,6 +90,8 @@ pub struct EvalOptions {
     /// Score a run directory whose completion record is missing or not `complete`
     /// ([`margemu_sim::rundir::check_complete`]), with a note saying so, instead of refusing it.
     pub allow_incomplete: bool,
+    /// How recovery after a fault window is judged ([`super::faults`]).
+    pub faults: super::faults::FaultOptions,
 }
 
 impl Default for EvalOptions {
@@ -101,6 +105,7 @@ impl Default for EvalOptions {
             device_time: true,
             rules: PhaseRules::default(),
             allow_incomplete: false,
+            faults: super::faults::FaultOptions::default(),
         }
     }
 }
@@ -243,6 +248,9 @@ pub struct Evaluation {
     pub traces: Traces,
     /// `errors.csv`, when it was written.
     pub errors_csv: Option<PathBuf>,
+    /// Scores per fault window of the directory's `events.csv`, in schedule order
+    /// ([`super::faults`]; empty without faults).
+    pub faults: Vec<super::faults::FaultScore>,
 }
 
 /// Runs one evaluation (see the module docs) without writing `errors.csv`.
@@ -286,8 +294,16 @@ pub fn evaluate_writing(
         latency_ns: latency_applied_ns,
         ..options.search.score
     };
+    let fault_dir = match source {
+        Source::Session(dir) | Source::Estimates { dir, .. } => Some(dir.as_path()),
+        Source::External { .. } => None,
+    };
+    let mut faults = match fault_dir {
+        Some(dir) => FaultScorer::from_dir(dir, options.faults)?,
+        None => FaultScorer::default(),
+    };
     let mut errors = errors_csv.map(ErrorsCsv::create).transpose()?;
-    let scored = score_pass(&loaded, &opts, errors.as_mut());
+    let scored = score_pass(&loaded, &opts, errors.as_mut(), &mut faults);
     let mut notes = loaded.notes.clone();
     if let Ok(s) = &scored {
         if loaded.rows.is_some() {
@@ -340,6 +356,7 @@ pub fn evaluate_writing(
         norms: loaded.norms,
         traces: scored.traces,
         errors_csv: errors_csv.map(Path::to_path_buf),
+        faults: faults.finish(),
     })
 }
 
@@ -357,6 +374,7 @@ fn score_pass(
     loaded: &Loaded,
     opts: &ScoreOptions,
     mut errors: Option<&mut ErrorsCsv>,
+    faults: &mut FaultScorer,
 ) -> Result<Scored, EvalError> {
     let max_gap = loaded.facts.max_gap_ns(opts);
     let first = loaded.facts.first_ns;
@@ -408,6 +426,9 @@ fn score_pass(
             out.row(&c, phase)?;
         }
         all.add(&c);
+        if !faults.is_empty() {
+            faults.add(c.t_ns, c.geodesic);
+        }
         if let Some(i) = phase.and_then(|p| Phase::ALL.iter().position(|&a| a == p)) {
             by_phase[i].add(&c);
         }

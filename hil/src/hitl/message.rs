@@ -132,6 +132,7 @@ mod tests {
             t_ns: 1_234_567,
             sample: Sample { acc, gyr, mag },
             disturbance: [0.0; 3],
+            dropout: 0,
         }
     }
 

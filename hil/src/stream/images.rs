@@ -8,6 +8,9 @@
 //! or [`ImageSettings::default_temp_c`]) → the chip module's conversion with the explicit
 //! [`ImageSettings::chip`] register settings ([`ChipSettings::image`]).
 //!
+//! The scene's sensor faults act in [`MargSim`] (each device's own), and a dropout marks the
+//! sensor's registers with the chip's invalid value ([`ChipSettings::faulted_image`]).
+//!
 //! A rig (`[[device]]`) does this for every device, each with its own model
 //! ([`MargSim::for_device`]: its seed and lever arm), in its own axes, with its own settings
 //! (the first device's are [`ImageSettings::chip`]), and the sample's image is every device's
@@ -104,10 +107,10 @@ pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<Pr
             let mut len = 0;
             let mut clips = Clips::default();
             for ((marg, chip, chip_settings), clip) in devices.iter_mut().zip(&mut clips) {
-                let s = marg
+                let marg_sample = marg
                     .try_sample(&scene, &in_chip_axes(truth, chip))
-                    .map_err(|e| Halt::Failed(margemu_sim::run::RunError::NonFinite(e)))?
-                    .sample;
+                    .map_err(|e| Halt::Failed(margemu_sim::run::RunError::NonFinite(e)))?;
+                let s = marg_sample.sample;
                 let sample = PhysicalSample {
                     acc: s.acc,
                     gyr: s.gyr,
@@ -117,7 +120,7 @@ pub fn predict_images(scene: &Scene, settings: &ImageSettings) -> Predictions<Pr
                     temp_c,
                 };
                 *clip = marg.clips();
-                let one = chip_settings.image(&sample);
+                let one = chip_settings.faulted_image(&sample, marg_sample.dropout);
                 let end = (len + one.len()).min(image.len());
                 image[len..end].copy_from_slice(&one[..end - len]);
                 len = end;

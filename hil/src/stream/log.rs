@@ -17,7 +17,7 @@
 //! | `device.csv` | `host_ns,device_time_ns,samples_served,index,served_time_ns,t_ns,underruns`: what the device reports it served, one row per Telemetry with `samples_served > 0`: the last index served, the device scene time it was served at, and that index's latch instant as the host scheduled it |
 //! | `telemetry.csv` | `host_ns,seq` then every Telemetry field: `time_ns,state,samples_served,underruns,overruns,crc_errors,framing_errors,lost_frames,rejected_messages,buffer_level,next_index,credit_limit,last_served_index,last_served_time_ns` |
 //! | `register_writes.csv` | `host_ns,time_ns,bus,address,register,value,dropped_before,device`: each write of the device under test (`bus` spi, i2c or aux; `address`: the I2C address, or on SPI the chip select of the device written, 0 for device 0; `dropped_before`: writes the device lost just before this batch; `device`: the name of the scene's device it reached, empty if none answers that address) |
-//! | `events.csv` | `host_ns,event,detail`: `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `resend_out_of_window` (a hole older than the items the session keeps: not resent), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
+//! | `events.csv` | `host_ns,event,detail`: first a `fault` row per window of the scene's fault schedule (at `host_ns` 0; format: [`margemu_sim::fault_log`]), then `hello_ack`, `configured` (credit, batch, lead), `start` (`start_host_ns`), `host_rx_errors` (the host's receive counters after a damaged or lost device frame), `resend` (a go-back-N: the device's `next_index` and when that item was last written), `resend_out_of_window` (a hole older than the items the session keeps: not resent), `device_error`, `device_reset`, `stopped` or `stop_unconfirmed`, and last `end` (`completed` or `error: …`); with a device under test, a `dut` row (its reader's summary) follows `end` |
 //!
 //! With [`StreamConfig::mcap`](super::StreamConfig::mcap), `session.mcap` is written beside
 //! them, by the same writer, from the same rows (`super::mcap_log`).
@@ -49,8 +49,8 @@ pub const DEVICE_FILE: &str = "device.csv";
 pub const TELEMETRY_FILE: &str = "telemetry.csv";
 /// `register_writes.csv`.
 pub const REGISTER_WRITES_FILE: &str = "register_writes.csv";
-/// `events.csv`.
-pub const EVENTS_FILE: &str = "events.csv";
+/// `events.csv` (its fault rows: [`margemu_sim::fault_log`]).
+pub const EVENTS_FILE: &str = margemu_sim::fault_log::EVENTS_FILE;
 
 /// The files of a session besides `meta.toml`.
 pub const SESSION_FILES: [&str; 9] = [
@@ -130,7 +130,7 @@ fn written_device(devices: &[WrittenDevice], bus: Bus, address: u8) -> &str {
     found.map_or("", |d| d.name.as_str())
 }
 /// Header of `events.csv`.
-pub const EVENTS_COLUMNS: &str = "host_ns,event,detail";
+pub const EVENTS_COLUMNS: &str = margemu_sim::fault_log::EVENTS_COLUMNS;
 
 /// The open CSV files of one session.
 pub struct SessionLog {

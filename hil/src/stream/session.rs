@@ -161,6 +161,11 @@ impl Session {
         };
         let devices = scene.devices();
         let mut log = SessionLog::create(dir, &meta, &sent, &devices).map_err(log_err)?;
+        // The scene's fault windows, first (margemu_sim::fault_log).
+        for detail in margemu_sim::fault_log::details(scene) {
+            let event = margemu_sim::fault_log::FAULT_EVENT;
+            log.event(0, event, &detail).map_err(log_err)?;
+        }
         if config.mcap {
             let images = matches!(items, Items::Images);
             let mcap =

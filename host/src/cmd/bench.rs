@@ -38,6 +38,13 @@ pub enum Cmd {
         #[arg(long, default_value_t = 0.5)]
         seconds: f64,
     },
+    /// What a schedule of four sensor faults costs per sample of the host's sensor model, idle
+    /// and with one active, against no faults (target: under 5 % when none is active).
+    Faults {
+        /// Least wall time spent timing the three rows, interleaved (s).
+        #[arg(long, default_value_t = 3.0)]
+        seconds: f64,
+    },
     /// What writing `run.mcap` costs per sample against the CSV files (truth + MARG, written
     /// to memory), in time and bytes.
     Mcap {
@@ -109,6 +116,26 @@ impl Cmd {
                 }
             }
             Cmd::Stream(cmd) => cmd.run()?,
+            Cmd::Faults { seconds } => {
+                println!(
+                    "host cost per output sample of the sensor model with a sensor-fault schedule \
+                     (1 kHz static scene, white noise on every sensor; the fastest of interleaved \
+                     1000-sample passes over {seconds} s)\n"
+                );
+                println!("| case | ns per sample | against no faults |");
+                println!("|---|---|---|");
+                let rows = margemu::perf_faults::fault_costs(Duration::from_secs_f64(seconds))
+                    .map_err(anyhow::Error::msg)?;
+                let base = rows[0].ns_per_sample;
+                for r in &rows {
+                    println!(
+                        "| {} | {:.1} | {:+.1} % |",
+                        r.case,
+                        r.ns_per_sample,
+                        (r.ns_per_sample / base - 1.0) * 100.0
+                    );
+                }
+            }
             Cmd::Chain { seconds } => {
                 println!(
                     "host cost per output sample of the sensor model behind each chip's sampling \

@@ -79,6 +79,17 @@ pub struct Cmd {
     /// completion record); the report then says so.
     #[arg(long)]
     allow_incomplete: bool,
+    /// Fault windows (events.csv): recovered once the geodesic error stays below this (°)
+    /// instead of --recovery-factor × its RMS before the window.
+    #[arg(long)]
+    recovery_threshold: Option<f64>,
+    /// Fault windows: the recovery threshold as a multiple of the geodesic RMS before the
+    /// window (at least 1°).
+    #[arg(long, default_value_t = 2.0)]
+    recovery_factor: f64,
+    /// Fault windows: how long the error must stay below the threshold (ms).
+    #[arg(long, default_value_t = 500.0)]
+    recovery_hold: f64,
 }
 
 fn ms_to_ns(name: &str, ms: f64) -> Result<u64> {
@@ -89,7 +100,27 @@ fn ms_to_ns(name: &str, ms: f64) -> Result<u64> {
 }
 
 impl Cmd {
+    fn fault_options(&self) -> Result<margemu::evaluate::faults::FaultOptions> {
+        let positive = |name: &str, x: f64| {
+            if x.is_finite() && x > 0.0 {
+                Ok(x)
+            } else {
+                bail!("--{name} must be a finite number > 0, not {x}")
+            }
+        };
+        Ok(margemu::evaluate::faults::FaultOptions {
+            factor: positive("recovery-factor", self.recovery_factor)?,
+            threshold_rad: self
+                .recovery_threshold
+                .map(|t| positive("recovery-threshold", t).map(f64::to_radians))
+                .transpose()?,
+            hold_ns: ms_to_ns("recovery-hold", self.recovery_hold)?,
+            ..Default::default()
+        })
+    }
+
     pub fn run(self) -> Result<()> {
+        let faults = self.fault_options()?;
         let (source, default_out) = match (&self.dir, &self.external) {
             (None, Some(file)) => {
                 let stem = file.file_stem().unwrap_or_default().to_string_lossy();
@@ -160,6 +191,7 @@ impl Cmd {
                 window_ns: ms_to_ns("window", self.window)?,
             },
             allow_incomplete: self.allow_incomplete,
+            faults,
         };
         let out = self.out.unwrap_or(default_out);
         let eval =

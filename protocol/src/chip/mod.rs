@@ -29,6 +29,7 @@
 
 pub mod chain;
 mod image;
+pub mod invalid;
 mod model;
 mod settings;
 

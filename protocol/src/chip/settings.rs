@@ -298,10 +298,22 @@ impl ChipSettings {
 
     /// Writes the chip's own invalid value into the data of the sensors in `sensors` (bits of
     /// `margemu_model::fault::Sensor::bit`) of an image this chip's [`ChipSettings::image`]
-    /// made: the dropout fault. Sensors the chip does not have are left alone.
+    /// made: the dropout fault. Sensors the chip does not have are left alone. Each family's
+    /// value and its source: [`super::invalid`].
     pub fn mark_invalid(&self, image: &mut Image, sensors: u8) {
-        // Filled in per chip family with the dropout fault (each chip module's invalid value).
-        let _ = (image, sensors);
+        super::invalid::mark(&self.conversion, self.model, image, sensors);
+    }
+
+    /// [`ChipSettings::image`] with the dropout mask `dropout` (what
+    /// `margemu_model::fault::SensorFaults::apply` returned for the sample) applied by
+    /// [`ChipSettings::mark_invalid`]: the served image of a faulted sample, on the host
+    /// (source (a)) and on the device (source (b)) alike.
+    pub fn faulted_image(&self, sample: &PhysicalSample, dropout: u8) -> Image {
+        let mut image = self.image(sample);
+        if dropout != 0 {
+            self.mark_invalid(&mut image, dropout);
+        }
+        image
     }
 
     /// The register image of `sample` (chip axes) under these settings, of the model's length

@@ -23,6 +23,7 @@
 pub mod builtin;
 pub mod chip;
 mod error;
+pub mod fault;
 pub mod ranges;
 pub mod rig;
 mod schema;
@@ -107,7 +108,7 @@ impl Scene {
             vibration: Vec::new(),
             sampling: vibration::SamplingPath::Auto,
             warnings,
-            faults: Vec::new(),
+            faults: checked.faults,
         };
         scene.check_gains()?;
         scene.resolve_vibration()?;

@@ -60,6 +60,9 @@ pub struct SceneSpec {
     /// Vibration: motor tones, random vibration, shocks (`[vibration]`); none when absent.
     #[serde(default)]
     pub vibration: super::vibration::VibrationSpec,
+    /// The fault schedule (`[[fault]]`, [`super::fault`]); none when absent.
+    #[serde(default)]
+    pub fault: Vec<super::fault::FaultSpec>,
 }
 
 /// How the plate's motion is produced; a scene pays only for the mode it names.

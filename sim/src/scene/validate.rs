@@ -15,6 +15,8 @@ pub(crate) struct Checked {
     pub others: Vec<super::rig::Device>,
     /// Legal but likely wrong inputs.
     pub warnings: Vec<Violation>,
+    /// The fault schedule (`[[fault]]`), device indices into the rig.
+    pub faults: Vec<margemu_model::fault::Fault>,
 }
 
 type Check = Result<(), Violation>;
@@ -52,7 +54,12 @@ pub(crate) fn check(spec: &SceneSpec) -> Result<Checked, Violation> {
     }
     check_sensors(spec)?;
     let (primary, others) = super::rig::resolve(spec.chip.as_ref(), &spec.device, spec.rate)?;
+    let devices: Vec<_> = std::iter::once(primary.clone())
+        .chain(others.iter().cloned())
+        .collect();
+    let faults = super::fault::resolve(&spec.fault, &devices, duration_ns)?;
     Ok(Checked {
+        faults,
         clock,
         duration_ns,
         step_ns,
