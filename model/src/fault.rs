@@ -311,6 +311,15 @@ impl FaultKind {
         }
     }
 
+    /// Whether it moves the instant a sample is latched (clock_offset, late, drdy_jitter). A
+    /// rig's devices share one serving clock, so only device 0 may have these.
+    pub const fn moves_latch(&self) -> bool {
+        matches!(
+            self,
+            FaultKind::ClockOffset { .. } | FaultKind::Late { .. } | FaultKind::DrdyJitter { .. }
+        )
+    }
+
     /// Whether it replaces the sensor's value (stuck, stuck-at, dropout).
     pub const fn replaces_value(&self) -> bool {
         matches!(

@@ -207,6 +207,19 @@ fn sensors_and_features_the_chip_does_not_have() {
         "13:8",
         "device `imu` is on SPI",
     );
+    // The rig's devices share one serving clock: only the first may have its latch moved.
+    assert_error(
+        &format!("{F}device = \"compass\"\nkind = \"late\"\ndelay = 100.0\nstart = 1.0\nduration = 1.0\n"),
+        "14:8",
+        "only the first device (`imu`) can have it",
+    );
+    let missing = faults(&format!(
+        "{F}device = \"compass\"\nkind = \"missing_drdy\"\nprobability = 0.5\nstart = 1.0\nduration = 1.0\n"
+    ));
+    assert_eq!(
+        missing[0].device, 1,
+        "a missing data-ready pulse is any device's"
+    );
 }
 
 #[test]

@@ -39,14 +39,6 @@ pub fn clock_lead_ns(ppm: f32, drift_ppm_per_s: f32, elapsed_ns: u64) -> f64 {
     (f64::from(ppm) * e + f64::from(drift_ppm_per_s) * e * e / 2.0) * 1e3
 }
 
-/// Whether `kind` moves the serving clock (clock_offset, late, drdy_jitter).
-pub fn shifts_latch(kind: &FaultKind) -> bool {
-    matches!(
-        kind,
-        FaultKind::ClockOffset { .. } | FaultKind::Late { .. } | FaultKind::DrdyJitter { .. }
-    )
-}
-
 /// Streams held at once: one jitter window and one missing-data-ready window per device.
 const STREAMS: usize = MAX_DEVICES + 1;
 
@@ -80,7 +72,7 @@ impl FaultClock {
         let mut at = i128::from(t_ns);
         for (pos, e) in schedule.iter().enumerate() {
             let f = &e.fault;
-            if f.device != 0 || !shifts_latch(&f.kind) {
+            if f.device != 0 || !f.kind.moves_latch() {
                 continue;
             }
             if !f.window.contains(t_ns) {

@@ -600,7 +600,7 @@ impl<const N: usize> Core<N> {
         let Some(chip) = self.rig.chip(usize::from(f.device)) else {
             return self.refuse(ErrorCode::FaultRefused, seq, FAULT_NO_DEVICE);
         };
-        let timing_elsewhere = f.device != 0 && faults::shifts_latch(&f.kind);
+        let timing_elsewhere = f.device != 0 && f.kind.moves_latch();
         if timing_elsewhere || !chip_fault_supported(chip, &f.kind) {
             return self.refuse(ErrorCode::FaultRefused, seq, FAULT_UNSUPPORTED);
         }

@@ -22,7 +22,6 @@
 //! assert_eq!((msgs.len(), msgs[0].seed), (1, 5));
 //! ```
 
-use margemu_firmware::link::faults::shifts_latch;
 use margemu_model::fault::MAX_FAULTS;
 use margemu_protocol::link::AddFault;
 use margemu_sim::marg::device_seed;
@@ -43,7 +42,7 @@ pub fn fault_refusal(scene: &Scene) -> Option<String> {
         .faults
         .iter()
         .enumerate()
-        .find(|(_, f)| f.device != 0 && shifts_latch(&f.kind))?;
+        .find(|(_, f)| f.device != 0 && f.kind.moves_latch())?;
     Some(format!(
         "fault {} ({} on device {}): a rig's devices share the device's one serving clock, \
          so only the first device's samples can be moved; put it on device 0",

@@ -279,6 +279,16 @@ fn resolve_one(
     let window = window(i, spec, duration_ns)?;
     let kind = params::kind(i, spec)?;
     check_device(i, &kind, device)?;
+    if index != 0 && kind.moves_latch() {
+        return Err(at(
+            "kind",
+            format!(
+                "a `{}` fault moves the instant samples are latched, and a rig's devices share \
+                 one serving clock: only the first device (`{}`) can have it",
+                spec.kind, devices[0].name
+            ),
+        ));
+    }
     Ok(Fault::new(index as u8, window, kind))
 }
 
