@@ -172,3 +172,55 @@ fn a_schedule_the_device_would_refuse_is_refused_before_anything_is_sent() {
     let err = Session::new(&s, config(), &dir).err().expect("refused");
     assert!(err.to_string().contains("17 faults"), "{err}");
 }
+
+/// The schedule's sensor faults and a dropout: source (a)'s images (the host's model) and
+/// source (b)'s (the device's model, kinematics at the output rate) are the same bytes, with
+/// the faults and without.
+#[test]
+fn both_source_modes_serve_the_same_faulted_bytes() {
+    use margemu::stream::predict_images;
+    let with_dropout = |mut s: Scene| {
+        s.faults.push(Fault::new(
+            0,
+            win(850, 900),
+            FaultKind::Dropout {
+                sensor: Sensor::Acc,
+            },
+        ));
+        s
+    };
+    let (clean, faulty) = (scene(1.0, 1000.0), with_dropout(faulty_scene()));
+    let mut differ = 0;
+    let mut per_scene = Vec::new();
+    for s in [&clean, &faulty] {
+        let settings = ImageSettings::for_scene(s);
+        // Source (b)'s die temperature without a `[sensors] temperature` ramp.
+        let images_settings = ImageSettings {
+            default_temp_c: margemu_firmware::link::setup::DEFAULT_TEMP_C,
+            ..settings
+        };
+        let a: Vec<_> = predict_images(s, &images_settings)
+            .map(|p| p.unwrap().image)
+            .collect();
+        let b: Vec<_> = predict_model(s, &settings, Some(1000.0))
+            .unwrap()
+            .samples
+            .map(|p| p.unwrap().sample.image)
+            .collect();
+        assert_eq!(a.len(), 1000);
+        for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+            assert_eq!(x, y, "sample {k}");
+        }
+        per_scene.push(a);
+    }
+    for k in 0..1000 {
+        differ += usize::from(per_scene[0][k] != per_scene[1][k]);
+    }
+    // The faults changed the bytes (stuck, noise, spikes, the dropout's −32768), in both modes.
+    assert!(differ > 300, "{differ} samples differ");
+    assert_eq!(
+        &per_scene[1][860][0..2],
+        &[0x80, 0x00],
+        "dropout: ACCEL_XOUT = −32768"
+    );
+}
