@@ -110,21 +110,22 @@ pub(crate) fn apply_b<T: Real>(c: [T; 4], v: [T; 3]) -> [T; 4] {
 #[inline(always)]
 pub fn predict<T: Real>(p: &mut Packed<T>, s: [T; 3], c: [T; 4], qq: T, qb: T) {
     let x = |i: usize, j: usize| p[at(i, j)];
-    // Columns of Y (4-vectors) and of Z (3-vectors).
-    let ycol: [[T; 4]; 3] = core::array::from_fn(|j| core::array::from_fn(|i| x(i, 4 + j)));
-    let zcol: [[T; 3]; 3] = core::array::from_fn(|j| core::array::from_fn(|i| x(4 + i, 4 + j)));
-    // Y⁻ column j = A·y_j + B·z_j.
-    let ynew: [[T; 4]; 3] = core::array::from_fn(|j| {
-        let (a, b) = (apply_a(s, ycol[j]), apply_b(c, zcol[j]));
-        [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
-    });
+    // Y⁻ column j = A·y_j + B·z_j (y_j, z_j the columns of Y and Z).
+    let mut ynew = [[T::ZERO; 4]; 3];
+    for (j, col) in ynew.iter_mut().enumerate() {
+        let yj = [x(0, 4 + j), x(1, 4 + j), x(2, 4 + j), x(3, 4 + j)];
+        let zj = [x(4, 4 + j), x(5, 4 + j), x(6, 4 + j)];
+        let (a, b) = (apply_a(s, yj), apply_b(c, zj));
+        *col = [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]];
+    }
     // G column j = A·x_j + B·(row j of Y); X symmetric, so x_j is also row j.
-    let g: [[T; 4]; 4] = core::array::from_fn(|j| {
+    let mut g = [[T::ZERO; 4]; 4];
+    for (j, col) in g.iter_mut().enumerate() {
         let xj = [x(0, j), x(1, j), x(2, j), x(3, j)];
         let yj = [x(j, 4), x(j, 5), x(j, 6)];
         let (a, b) = (apply_a(s, xj), apply_b(c, yj));
-        [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
-    });
+        *col = [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]];
+    }
     // Row i of X⁻ = A·(row i of G) + B·(row i of Y⁻).
     for i in 0..4 {
         let gi = [g[0][i], g[1][i], g[2][i], g[3][i]];
@@ -143,35 +144,61 @@ pub fn predict<T: Real>(p: &mut Packed<T>, s: [T; 3], c: [T; 4], qq: T, qb: T) {
     }
 }
 
-/// One scalar measurement `y = h·x + v`, `h` nonzero only in the quaternion block (`h4`),
-/// `var(v) = r`: updates `p` and returns the gain `k` (7), or `None` (and leaves `p` alone) when
-/// the innovation variance `s = h·P·hᵀ + r` is not finite and positive.
+/// The three scalar measurements `yᵢ = hᵢ·x + vᵢ` of one reference vector, processed one after
+/// the other, `hᵢ` nonzero only in the quaternion block (`h[i]`), `var(vᵢ) = r`: updates `p`
+/// and returns the gain `kᵢ` of each row (7), or `None` for a row whose innovation variance
+/// `sᵢ = hᵢ·P·hᵢᵀ + r` (with `P` as the earlier rows left it) is not finite and positive; such
+/// a row leaves `P` alone.
 ///
-/// With `u = P hᵀ` (the first four rows of `P` only) and `k = u / s`, the Joseph form
-/// `P⁺ = (I − k h) P (I − k h)ᵀ + r k kᵀ` expands for any gain into
-/// `P⁺ = P − (k uᵀ + u kᵀ) + s·k kᵀ = P − u kᵀ + k eᵀ`, `e = s·k − u`.
-/// `e` is what the rounding of `k` leaves of `s·k − u` (zero in exact arithmetic), so the update
-/// costs two multiply–adds per stored entry and still keeps the Joseph form's property that a
-/// rounding error in `k` changes `P⁺` only to second order.
+/// One scalar update is `P⁺ = P − u kᵀ` with `u = P hᵀ`, `s = h·u + r`, `k = u / s` (the
+/// Joseph form `(I − k h) P (I − k h)ᵀ + r k kᵀ` at this gain). Processing the rows in turn
+/// needs each row's `uᵢ` from the `P` the earlier rows left, and that is
+/// `uᵢ = P hᵢᵀ − Σⱼ₍<ᵢ₎ kⱼ·(hᵢ·uⱼ)` with the `P` before the vector, since
+/// `(P − uⱼ kⱼᵀ)·hᵢᵀ = P hᵢᵀ − uⱼ (kⱼ·hᵢ) = P hᵢᵀ − kⱼ (hᵢ·uⱼ)` (`kⱼ` is a multiple of `uⱼ`).
+/// So the rows cost three products `P hᵢᵀ` (four rows of `P` each: `h` is zero in the bias
+/// states) and a few 7-vector corrections, and `P` is written once, as the rank-three update
+/// `P − Σᵢ uᵢ kᵢᵀ` of its 28 stored entries. The result equals the three scalar updates in
+/// exact arithmetic.
 #[inline(always)]
-pub fn scalar_update<T: Real>(p: &mut Packed<T>, h4: [T; 4], r: T) -> Option<[T; N]> {
-    let u: [T; N] = core::array::from_fn(|j| {
-        h4[0] * p[at(0, j)] + h4[1] * p[at(1, j)] + h4[2] * p[at(2, j)] + h4[3] * p[at(3, j)]
-    });
-    let s = h4[0] * u[0] + h4[1] * u[1] + h4[2] * u[2] + h4[3] * u[3] + r;
-    if !(s.is_finite() && s > T::ZERO) {
-        return None;
-    }
-    let inv = T::ONE / s;
-    let k: [T; N] = core::array::from_fn(|j| u[j] * inv);
-    let e: [T; N] = core::array::from_fn(|j| s * k[j] - u[j]);
-    for i in 0..N {
-        for j in i..N {
-            let v = &mut p[at(i, j)];
-            *v = (*v - u[i] * k[j]) + k[i] * e[j];
+pub fn vector_update<T: Real>(p: &mut Packed<T>, h: &[[T; 4]; 3], r: T) -> [Option<[T; N]>; 3] {
+    let mut u = [[T::ZERO; N]; 3];
+    let mut k = [[T::ZERO; N]; 3];
+    let mut ok = [false; 3];
+    for i in 0..3 {
+        let hi = h[i];
+        let mut ui = [T::ZERO; N];
+        for (j, v) in ui.iter_mut().enumerate() {
+            *v = hi[0] * p[at(0, j)]
+                + hi[1] * p[at(1, j)]
+                + hi[2] * p[at(2, j)]
+                + hi[3] * p[at(3, j)];
+        }
+        for j in 0..i {
+            if ok[j] {
+                let uj = u[j];
+                let c = hi[0] * uj[0] + hi[1] * uj[1] + hi[2] * uj[2] + hi[3] * uj[3];
+                for (v, kj) in ui.iter_mut().zip(k[j]) {
+                    *v -= kj * c;
+                }
+            }
+        }
+        let s = hi[0] * ui[0] + hi[1] * ui[1] + hi[2] * ui[2] + hi[3] * ui[3] + r;
+        if s.is_finite() && s > T::ZERO {
+            let inv = T::ONE / s;
+            for (kv, &uv) in k[i].iter_mut().zip(&ui) {
+                *kv = uv * inv;
+            }
+            u[i] = ui;
+            ok[i] = true;
         }
     }
-    Some(k)
+    // Rows refused have u = k = 0 and drop out.
+    for a in 0..N {
+        for b in a..N {
+            p[at(a, b)] -= (u[0][a] * k[0][b] + u[1][a] * k[1][b]) + u[2][a] * k[2][b];
+        }
+    }
+    [0, 1, 2].map(|i| if ok[i] { Some(k[i]) } else { None })
 }
 
 /// Whether every entry is finite and every diagonal entry positive (a cheap guard; the tests
@@ -301,53 +328,62 @@ mod tests {
         assert_close(&unpack(&got), &expect);
     }
 
-    #[test]
-    fn scalar_update_is_the_kalman_update() {
-        let p = spd();
-        let h4 = [0.3, -1.2, 0.5, 2.0];
-        let h = [h4[0], h4[1], h4[2], h4[3], 0.0, 0.0, 0.0];
-        let r = 0.01;
-        let u: [f64; N] = core::array::from_fn(|j| (0..N).map(|k| p[j][k] * h[k]).sum());
-        let s: f64 = (0..N).map(|k| h[k] * u[k]).sum::<f64>() + r;
-        let mut expect = p;
-        for i in 0..N {
-            for j in 0..N {
-                expect[i][j] -= u[i] * u[j] / s;
+    /// Three textbook scalar Kalman updates `P − u uᵀ / s`, one after the other; `None` for a
+    /// row refused.
+    fn sequential(p: &Cov<f64>, h: &[[f64; 4]; 3], r: f64) -> (Cov<f64>, [Option<[f64; N]>; 3]) {
+        let mut p = *p;
+        let mut gains = [None; 3];
+        for (i, h4) in h.iter().enumerate() {
+            let hh = [h4[0], h4[1], h4[2], h4[3], 0.0, 0.0, 0.0];
+            let u: [f64; N] = core::array::from_fn(|j| (0..N).map(|k| p[j][k] * hh[k]).sum());
+            let s: f64 = (0..N).map(|k| hh[k] * u[k]).sum::<f64>() + r;
+            if !(s.is_finite() && s > 0.0) {
+                continue;
             }
+            for a in 0..N {
+                for b in 0..N {
+                    p[a][b] -= u[a] * u[b] / s;
+                }
+            }
+            gains[i] = Some(u.map(|v| v / s));
+        }
+        (p, gains)
+    }
+
+    #[test]
+    fn vector_update_is_three_kalman_updates() {
+        let p = spd();
+        let rows = [
+            [0.3, -1.2, 0.5, 2.0],
+            [1.1, 0.4, -0.7, 0.2],
+            [-0.5, 0.9, 1.3, -0.6],
+        ];
+        let mut nan_row = rows;
+        nan_row[1] = [f64::NAN; 4];
+        for h in [rows, nan_row] {
+            let (expect, gains) = sequential(&p, &h, 0.01);
+            let mut got = pack(&p);
+            let k = vector_update(&mut got, &h, 0.01);
+            assert_close(&unpack(&got), &expect);
+            for i in 0..3 {
+                assert_eq!(k[i].is_some(), gains[i].is_some(), "row {i}");
+                if let (Some(k), Some(g)) = (k[i], gains[i]) {
+                    assert!((0..N).all(|j| (k[j] - g[j]).abs() < 1e-14), "row {i}");
+                }
+            }
+            assert!(is_sane(&got));
         }
         let mut got = pack(&p);
-        let k = scalar_update(&mut got, h4, r).unwrap();
-        assert_close(&unpack(&got), &expect);
-        for j in 0..N {
-            assert!((k[j] - u[j] / s).abs() < 1e-15);
-        }
-        assert!(is_sane(&got));
-        let before = got;
-        assert_eq!(scalar_update(&mut got, [f64::NAN; 4], r), None);
-        assert_eq!(got, before);
+        assert_eq!(
+            vector_update(&mut got, &[[f64::NAN; 4]; 3], 0.01),
+            [None; 3]
+        );
+        assert_eq!(got, pack(&p));
         let mut bad = got;
         bad[at(3, 3)] = -1.0;
         assert!(!is_sane(&bad));
         let mut bad = got;
         bad[at(2, 5)] = f64::INFINITY;
         assert!(!is_sane(&bad));
-    }
-
-    /// The rank-one form `P − u kᵀ + k eᵀ` is the Joseph expansion `P − (k uᵀ + u kᵀ) + s k kᵀ`
-    /// for any gain, not only the optimal one.
-    #[test]
-    fn rank_one_form_is_the_joseph_expansion_for_any_gain() {
-        let p = spd();
-        let u = [0.3, -0.2, 0.7, 0.1, -0.4, 0.25, 0.05];
-        let k = [0.11, 0.02, -0.3, 0.4, 0.07, -0.15, 0.2];
-        let s = 1.7;
-        let e: [f64; N] = core::array::from_fn(|j| s * k[j] - u[j]);
-        for i in 0..N {
-            for j in 0..N {
-                let joseph = p[i][j] - (k[i] * u[j] + u[i] * k[j]) + s * k[i] * k[j];
-                let ours = p[i][j] - u[i] * k[j] + k[i] * e[j];
-                assert!((joseph - ours).abs() < 1e-15, "[{i}][{j}]");
-            }
-        }
     }
 }

@@ -19,15 +19,17 @@
 //! so the six rows are processed one at a time: scalar innovation variance, no matrix inverse.
 //! All six are linearized at `x⁻`, and each innovation subtracts what the earlier rows already
 //! corrected (`y_i = z_i − h_i(x⁻) − H_i·δx`), so the result equals the batch update of eq. 26.
-//! The covariance update is Joseph form (see [`covariance::scalar_update`]); then
-//! `q = normalize(q⁻ + δq)`, `b = b⁻ + δb`.
+//! Each row's covariance update is `P − u kᵀ` (`u = P hᵀ`, `k = u / s`), the Joseph form at
+//! this gain; then `q = normalize(q⁻ + δq)`, `b = b⁻ + δb`.
 //!
 //! **Cost.** The structure does the work ([`covariance`]): `P` is kept as its packed upper
 //! triangle (28 entries); the prediction works on the blocks of `P` and applies `A` and `B` as
 //! the quaternion products they are (`A·v = v + Ω(Tₛ/2·w)·v`, `B·v = Ξ(−Tₛ/2·q)·v`, twelve
 //! multiplications per vector), since the lower rows of `Φ` are the identity; each measurement row is zero in the bias
-//! states, so `P hᵀ` reads four rows, and its update is one rank-one correction of the 28
-//! entries (`P − u kᵀ + k eᵀ`, two multiply–adds each). The same filter written the plain way
+//! states, so `P hᵀ` reads four rows; and the three rows of one vector write `P` once, as a
+//! rank-three update of the 28 entries, each row's `u` being corrected for the earlier rows
+//! instead of read from an updated `P` ([`covariance::vector_update`], equal in exact
+//! arithmetic to three scalar updates). The same filter written the plain way
 //! (whole matrix, `[A B]·P·[A B]ᵀ`, full Joseph expansion per row) is kept in
 //! `tests/common/ekf_reference.rs`; `tests/ekf_reference.rs` checks that both give the same
 //! estimates and covariance, and `docs/filters.md` (*Cost*) has the timings.
@@ -72,7 +74,7 @@ use crate::filter::{AttitudeFilter, Diagnostics, Imu};
 use crate::init::{parameter, Initial, Shared, DEFAULT_MAG_REFERENCE};
 use crate::quat::{axpy, cross, integrate, normalize, scale, Quat, Vec3};
 use crate::{Error, Real};
-use covariance::{is_sane, predict, scalar_update, unpack, Cov, Packed, N, PACKED};
+use covariance::{is_sane, predict, unpack, vector_update, Cov, Packed, N, PACKED};
 
 /// Parameters of the [`Ekf`]: the paper's four noise statistics, the initial uncertainty, the
 /// reference field and the start.
@@ -223,10 +225,12 @@ impl<T: Real> Ekf<T> {
     #[inline(always)]
     fn correct(&mut self, q: Quat<T>, r: Vec3<T>, z: Vec3<T>, var: T, dx: &mut [T; N]) {
         let (predicted, rows) = observe(q, r);
-        for (i, h) in rows.into_iter().enumerate() {
+        // The gains do not depend on the innovations: all three first, then the state.
+        let gains = vector_update(&mut self.p, &rows, var);
+        for (i, (h, gain)) in rows.into_iter().zip(gains).enumerate() {
             let y =
                 z[i] - predicted[i] - (h[0] * dx[0] + h[1] * dx[1] + h[2] * dx[2] + h[3] * dx[3]);
-            match scalar_update(&mut self.p, h, var) {
+            match gain {
                 Some(k) => {
                     for j in 0..N {
                         dx[j] += k[j] * y;

@@ -6,6 +6,8 @@
 //! scalar update of every entry for each of the six measurement rows. Only public items of the
 //! crate are used; the start (`Initial`) and the input checks are copied from its `init` module.
 
+#![allow(dead_code)]
+
 use margemu_filters::init::triad;
 use margemu_filters::quat::{axpy, cross, identity, integrate, normalize, scale, Quat, Vec3};
 use margemu_filters::{AttitudeFilter, Diagnostics, EkfConfig, Imu, Initial, Real};
