@@ -134,8 +134,8 @@ fn paper_scene_with_large_bias() {
     let samples: Vec<Imu<f64>> = (0..120_000)
         .map(|_| {
             let mut imu = widen(&scene.next().1);
-            for i in 0..3 {
-                imu.gyro[i] += bias[i];
+            for (g, b) in imu.gyro.iter_mut().zip(bias) {
+                *g += b;
             }
             imu
         })

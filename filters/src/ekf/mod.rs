@@ -382,6 +382,8 @@ mod tests {
     }
 
     #[test]
+    // Matrices indexed the way the formulas write them.
+    #[allow(clippy::needless_range_loop)]
     fn transition_matrix_matches_finite_differences() {
         let (q, g, bias, h) = (
             from_euler_zyx([0.4f64, -1.1, 2.9]),
