@@ -1,5 +1,5 @@
-//! The 7×7 covariance of the EKF and the two operations on it: prediction and one scalar
-//! measurement update.
+//! The 7×7 covariance of the EKF and the two operations on it: prediction, and the update by
+//! the three measurement rows of one reference vector.
 //!
 //! The matrix is symmetric, so only its upper triangle is stored: 28 entries, packed row by row
 //! ([`Packed`], indexed through [`at`]). Each operation computes each of those entries once, so
@@ -8,7 +8,8 @@
 //! * the prediction works on the blocks `P = [[X, Y], [Yᵀ, Z]]` (`X` 4×4 attitude, `Y` 4×3
 //!   attitude–bias, `Z` 3×3 bias) of `Φ = [[A, B], [0, I]]`, whose lower rows are the identity;
 //! * a measurement row is zero in the bias states, so `u = P hᵀ` reads only the first four rows,
-//!   and the update is a rank-one correction of the 28 entries.
+//!   and the three rows of one vector write `P` once, as a rank-three correction of the 28
+//!   entries.
 
 use crate::Real;
 
@@ -71,8 +72,8 @@ pub fn unpack<T: Real>(p: &Packed<T>) -> Cov<T> {
     out
 }
 
-/// `S·v` for the skew-symmetric `S = Ω(hw)`, `(hw)` = `s`: the part of `A·v = v + S·v`
-/// beyond the identity (`q ⊗ (0, s) = Ω(s)·q`).
+/// `Ω(s)·v = v ⊗ (0, s)` (`Ω` as in the module docs of the EKF), skew-symmetric in its 4×4
+/// form: the part of `A·v = v + Ω(s)·v` beyond the identity, with `s = Tₛ/2·w`.
 #[inline(always)]
 fn omega<T: Real>(s: [T; 3], v: [T; 4]) -> [T; 4] {
     [
@@ -90,7 +91,7 @@ pub(crate) fn apply_a<T: Real>(s: [T; 3], v: [T; 4]) -> [T; 4] {
     [v[0] + o[0], v[1] + o[1], v[2] + o[2], v[3] + o[3]]
 }
 
-/// `B·v = −h·Ξ(q)·v = Ξ(c)·v` with `c = −h·q`: `vec`-free form of `c ⊗ (0, v)`.
+/// `B·v = −h·Ξ(q)·v = Ξ(c)·v = c ⊗ (0, v)` with `c = −h·q`.
 #[inline(always)]
 pub(crate) fn apply_b<T: Real>(c: [T; 4], v: [T; 3]) -> [T; 4] {
     [

@@ -25,12 +25,12 @@
 //! **Cost.** The structure does the work ([`covariance`]): `P` is kept as its packed upper
 //! triangle (28 entries); the prediction works on the blocks of `P` and applies `A` and `B` as
 //! the quaternion products they are (`A·v = v + Ω(Tₛ/2·w)·v`, `B·v = Ξ(−Tₛ/2·q)·v`, twelve
-//! multiplications per vector), since the lower rows of `Φ` are the identity; each measurement row is zero in the bias
-//! states, so `P hᵀ` reads four rows; and the three rows of one vector write `P` once, as a
-//! rank-three update of the 28 entries, each row's `u` being corrected for the earlier rows
-//! instead of read from an updated `P` ([`covariance::vector_update`], equal in exact
-//! arithmetic to three scalar updates). The same filter written the plain way
-//! (whole matrix, `[A B]·P·[A B]ᵀ`, full Joseph expansion per row) is kept in
+//! multiplications per vector), since the lower rows of `Φ` are the identity; each measurement
+//! row is zero in the bias states, so `P hᵀ` reads four rows; and the three rows of one vector
+//! write `P` once, as a rank-three update of the 28 entries, each row's `u` being corrected for
+//! the earlier rows instead of read from an updated `P` ([`covariance::vector_update`], equal in
+//! exact arithmetic to three scalar updates). The same filter written the plain way (whole
+//! matrix, `[A B]·P·[A B]ᵀ`, full Joseph expansion per row) is kept in
 //! `tests/common/ekf_reference.rs`; `tests/ekf_reference.rs` checks that both give the same
 //! estimates and covariance, and `docs/filters.md` (*Cost*) has the timings.
 //!
