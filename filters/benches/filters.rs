@@ -6,16 +6,27 @@
 //! implementation of the same algorithm family, timed in the same run so that ratios hold on a
 //! shared machine.
 //!
+//! The EKF is timed twice: `ekf_*` is the filter of the crate, `ekf_reference_*` the
+//! straightforward implementation it replaced (`tests/common/ekf_reference.rs`, the oracle of
+//! `tests/ekf_reference.rs`), so that before and after come from one run.
+//!
 //! `cargo bench -p margemu-filters -- --warm-up-time 1 --measurement-time 3`
+//!
+//! With `MARGEMU_BENCH_SAMPLES=<file>` set, the bench first writes its input there, one sample
+//! a line (`gx gy gz ax ay az mx my mz`, rad/s, m/s², model field units), so that another
+//! implementation can be timed on the same samples (`docs/filters.md`, *Cost*).
 
 // criterion_group! generates an undocumented public function.
 #![allow(missing_docs)]
 
 #[path = "../tests/common/mod.rs"]
 mod common;
+#[path = "../tests/common/ekf_reference.rs"]
+mod ekf_reference;
 
 use common::{widen, Scene};
 use criterion::{criterion_group, criterion_main, Criterion};
+use ekf_reference::ReferenceEkf;
 use margemu_filters::{AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, Imu, Real};
 use std::hint::black_box;
 
@@ -76,13 +87,23 @@ macro_rules! baseline {
 fn bench(c: &mut Criterion) {
     let single = samples();
     let double: Vec<Imu<f64>> = single.iter().map(widen).collect();
+    if let Some(path) = std::env::var_os("MARGEMU_BENCH_SAMPLES") {
+        let mut text = String::new();
+        for i in &double {
+            let [g, a, m] = [i.gyro, i.acc, i.mag];
+            let line: Vec<String> = [g, a, m].concat().iter().map(f64::to_string).collect();
+            text.push_str(&line.join(" "));
+            text.push('\n');
+        }
+        std::fs::write(path, text).expect("cannot write MARGEMU_BENCH_SAMPLES");
+    }
     baseline!(c, f32, "baseline_ahrs_madgwick_f32", single);
     baseline!(c, f64, "baseline_ahrs_madgwick_f64", double);
     bench_all(c, "f32", &single);
     bench_all(c, "f64", &double);
 }
 
-/// ECF, GDA and EKF with default parameters in `T`.
+/// ECF, GDA, EKF and the reference EKF with default parameters in `T`.
 fn bench_all<T: Real>(c: &mut Criterion, ty: &str, input: &[Imu<T>]) {
     let ecf = Ecf::<T>::new(&EcfConfig::default()).unwrap();
     let gda = Gda::<T>::new(&GdaConfig::default()).unwrap();
@@ -90,6 +111,8 @@ fn bench_all<T: Real>(c: &mut Criterion, ty: &str, input: &[Imu<T>]) {
     bench_filter(c, &format!("ecf_{ty}"), ecf, input);
     bench_filter(c, &format!("gda_{ty}"), gda, input);
     bench_filter(c, &format!("ekf_{ty}"), ekf, input);
+    let reference = ReferenceEkf::<T>::new(&EkfConfig::default());
+    bench_filter(c, &format!("ekf_reference_{ty}"), reference, input);
 }
 
 criterion_group!(benches, bench);

@@ -4,7 +4,7 @@
 //! gyroscope bias `b` (3, rad/s), with a 7×7 covariance `P`.
 //!
 //! **Predict.** `q⁻ = normalize(q + Tₛ/2 · q ⊗ (0, Ω − b))`, `b⁻ = b`,
-//! `P⁻ = Φ P Φᵀ + Q` with `Φ = [[I + Tₛ/2·Ω(Ω − b), −Tₛ/2·Ξ(q)], [0, I]]`
+//! `P⁻ = Φ P Φᵀ + Q` with `Φ = [[A, B], [0, I]]`, `A = I + Tₛ/2·Ω(Ω − b)`, `B = −Tₛ/2·Ξ(q)`
 //! (`q ⊗ (0, ω) = Ω(ω)·q = Ξ(q)·ω`) and
 //! `Q = diag(Tₛ·σ_g²/4 · I₄, Tₛ·σ_b² · I₃)`: `σ_g` is the gyroscope noise density and `σ_b` the
 //! bias random walk, so `Q` follows `Tₛ` and the tuning does not depend on the rate. White gyro
@@ -19,8 +19,20 @@
 //! so the six rows are processed one at a time: scalar innovation variance, no matrix inverse.
 //! All six are linearized at `x⁻`, and each innovation subtracts what the earlier rows already
 //! corrected (`y_i = z_i − h_i(x⁻) − H_i·δx`), so the result equals the batch update of eq. 26.
-//! The covariance update is Joseph form (see [`covariance::scalar_update`]), computed on the
-//! upper triangle and mirrored; then `q = normalize(q⁻ + δq)`, `b = b⁻ + δb`.
+//! Each row's covariance update is `P − u kᵀ` (`u = P hᵀ`, `k = u / s`), the Joseph form at
+//! this gain; then `q = normalize(q⁻ + δq)`, `b = b⁻ + δb`.
+//!
+//! **Cost.** The structure does the work ([`covariance`]): `P` is kept as its packed upper
+//! triangle (28 entries); the prediction works on the blocks of `P` and applies `A` and `B` as
+//! the quaternion products they are (`A·v = v + Ω(Tₛ/2·w)·v`, `B·v = Ξ(−Tₛ/2·q)·v`, twelve
+//! multiplications per vector), since the lower rows of `Φ` are the identity; each measurement
+//! row is zero in the bias states, so `P hᵀ` reads four rows; and the three rows of one vector
+//! write `P` once, as a rank-three update of the 28 entries, each row's `u` being corrected for
+//! the earlier rows instead of read from an updated `P` ([`covariance::vector_update`], equal in
+//! exact arithmetic to three scalar updates). The same filter written the plain way (whole
+//! matrix, `[A B]·P·[A B]ᵀ`, full Joseph expansion per row) is kept in
+//! `tests/common/ekf_reference.rs`; `tests/ekf_reference.rs` checks that both give the same
+//! estimates and covariance, and `docs/filters.md` (*Cost*) has the timings.
 //!
 //! **Guards.** A missing vector skips its three rows. A row whose innovation variance is not
 //! positive and finite is skipped; a step that would leave a non-finite state or a covariance
@@ -62,7 +74,7 @@ use crate::filter::{AttitudeFilter, Diagnostics, Imu};
 use crate::init::{parameter, Initial, Shared, DEFAULT_MAG_REFERENCE};
 use crate::quat::{axpy, cross, integrate, normalize, scale, Quat, Vec3};
 use crate::{Error, Real};
-use covariance::{is_sane, predict, scalar_update, Cov, N};
+use covariance::{is_sane, predict, unpack, vector_update, Cov, Packed, N, PACKED};
 
 /// Parameters of the [`Ekf`]: the paper's four noise statistics, the initial uncertainty, the
 /// reference field and the start.
@@ -108,8 +120,9 @@ impl Default for EkfConfig {
 pub struct Ekf<T> {
     s: Shared<T>,
     bias: Vec3<T>,
-    p: Cov<T>,
-    p0: Cov<T>,
+    /// The covariance, packed upper triangle.
+    p: Packed<T>,
+    p0: Packed<T>,
     /// `σ_g²/4` and `σ_b²`: times `Tₛ`, the diagonal of `Q`.
     q_att: T,
     q_bias: T,
@@ -143,8 +156,9 @@ fn observe<T: Real>(q: Quat<T>, r: Vec3<T>) -> (Vec3<T>, [[T; 4]; 3]) {
 }
 
 /// The blocks of `Φ = [[A, B], [0, I]]` for `q⁻ = q + h·q ⊗ (0, g − b)` at the bias-corrected
-/// rate `w = g − b` and `h = Tₛ/2`: `A = I + h·Ω(w)`, `B = −h·Ξ(q)`.
-#[inline(always)]
+/// rate `w = g − b` and `h = Tₛ/2`: `A = I + h·Ω(w)`, `B = −h·Ξ(q)`, as matrices (the filter
+/// applies them as products; the tests check both).
+#[cfg(test)]
 fn transition<T: Real>(q: Quat<T>, w: Vec3<T>, h: T) -> ([[T; 4]; 4], [[T; 3]; 4]) {
     let (hx, hy, hz) = (h * w[0], h * w[1], h * w[2]);
     let a = [
@@ -162,11 +176,11 @@ fn transition<T: Real>(q: Quat<T>, w: Vec3<T>, h: T) -> ([[T; 4]; 4], [[T; 3]; 4
     (a, b)
 }
 
-/// `diag(a, a, a, a, b, b, b)`.
-fn diagonal<T: Real>(a: T, b: T) -> Cov<T> {
-    let mut p = [[T::ZERO; N]; N];
-    for (i, row) in p.iter_mut().enumerate() {
-        row[i] = if i < 4 { a } else { b };
+/// `diag(a, a, a, a, b, b, b)`, packed.
+fn diagonal<T: Real>(a: T, b: T) -> Packed<T> {
+    let mut p = [T::ZERO; PACKED];
+    for i in 0..N {
+        p[covariance::at(i, i)] = if i < 4 { a } else { b };
     }
     p
 }
@@ -202,7 +216,7 @@ impl<T: Real> Ekf<T> {
 
     /// The state covariance, order `(qw, qx, qy, qz, bx, by, bz)`; exactly symmetric.
     pub fn covariance(&self) -> Cov<T> {
-        self.p
+        unpack(&self.p)
     }
 
     /// Corrects `q` (unit) and `dx` with the three rows of one reference vector `r` (world,
@@ -211,10 +225,12 @@ impl<T: Real> Ekf<T> {
     #[inline(always)]
     fn correct(&mut self, q: Quat<T>, r: Vec3<T>, z: Vec3<T>, var: T, dx: &mut [T; N]) {
         let (predicted, rows) = observe(q, r);
-        for (i, h) in rows.into_iter().enumerate() {
+        // The gains do not depend on the innovations: all three first, then the state.
+        let gains = vector_update(&mut self.p, &rows, var);
+        for (i, (h, gain)) in rows.into_iter().zip(gains).enumerate() {
             let y =
                 z[i] - predicted[i] - (h[0] * dx[0] + h[1] * dx[1] + h[2] * dx[2] + h[3] * dx[3]);
-            match scalar_update(&mut self.p, h, var) {
+            match gain {
                 Some(k) => {
                     for j in 0..N {
                         dx[j] += k[j] * y;
@@ -234,11 +250,10 @@ impl<T: Real> AttitudeFilter<T> for Ekf<T> {
         let (q, p_old) = (self.s.q, self.p);
         let w = axpy(step.gyro, -T::ONE, self.bias);
         let h = T::HALF * step.dt;
-        let (a, b) = transition(q, w, h);
         predict(
             &mut self.p,
-            &a,
-            &b,
+            scale(w, h),
+            scale(q, -h),
             self.q_att * step.dt,
             self.q_bias * step.dt,
         );
@@ -367,6 +382,8 @@ mod tests {
     }
 
     #[test]
+    // Matrices indexed the way the formulas write them.
+    #[allow(clippy::needless_range_loop)]
     fn transition_matrix_matches_finite_differences() {
         let (q, g, bias, h) = (
             from_euler_zyx([0.4f64, -1.1, 2.9]),
@@ -380,6 +397,23 @@ mod tests {
         };
         let w = [0, 1, 2].map(|i| g[i] - bias[i]);
         let (a, b) = transition(q, w, h);
+        // The products the filter applies are these matrices.
+        for k in 0..4 {
+            let e: [f64; 4] = core::array::from_fn(|i| f64::from(u8::from(i == k)));
+            let col = covariance::apply_a([h * w[0], h * w[1], h * w[2]], e);
+            assert!(
+                (0..4).all(|i| (col[i] - a[i][k]).abs() < 1e-15),
+                "A col {k}"
+            );
+        }
+        for k in 0..3 {
+            let e: [f64; 3] = core::array::from_fn(|i| f64::from(u8::from(i == k)));
+            let col = covariance::apply_b(q.map(|c| -h * c), e);
+            assert!(
+                (0..4).all(|i| (col[i] - b[i][k]).abs() < 1e-15),
+                "B col {k}"
+            );
+        }
         let x = [q[0], q[1], q[2], q[3], bias[0], bias[1], bias[2]];
         for k in 0..7 {
             let (mut up, mut down) = (x, x);
