@@ -12,6 +12,7 @@
 //! | Start | `t0` and `end_index` (until Stop, or a scene end) |
 //! | Stop | |
 //! | images | a batch of images of the input's length from any first index |
+//! | AddFault | a fault of any kind (valid parameters, or any bytes after a valid header) on any device, with any window |
 //! | clock | the device clock jumps forward by any amount up to ~2⁶⁰ ns, or back by up to 1 s |
 //! | poll | the device serves what is due and sends what it has |
 //! | SPI | a burst read or a write of any register through the chip's SPI target, maybe left selected |
@@ -27,10 +28,11 @@
 
 use margemu_firmware::chip::{I2cTarget, SpiTarget};
 use margemu_firmware::link::Device;
+use margemu_firmware::model::fault::{Fault, FaultKind, Sensor, Window};
 use margemu_protocol::chip::{ChipModel, Image};
 use margemu_protocol::link::{
-    stuff, Accumulator, Configure, FeedResult, Frame, FrameRepr, Hello, ImageBatch, Message, Rate,
-    Start, CRC_LEN, FRAME_VERSION, HEADER_LEN, MAX_FRAME_LEN, MAX_WIRE_LEN,
+    stuff, Accumulator, AddFault, Configure, FeedResult, Frame, FrameRepr, Hello, ImageBatch, Kind,
+    Message, Rate, Start, CRC_LEN, FRAME_VERSION, HEADER_LEN, MAX_FRAME_LEN, MAX_WIRE_LEN,
 };
 use margemu_protocol::PROTOCOL_VERSION;
 
@@ -91,10 +93,11 @@ enum Op {
     Poll,
     Spi,
     I2c,
+    AddFault,
 }
 
 impl Op {
-    const ALL: [Op; 11] = [
+    const ALL: [Op; 12] = [
         Op::RawBytes,
         Op::RawFrame,
         Op::Hello,
@@ -106,6 +109,7 @@ impl Op {
         Op::Poll,
         Op::Spi,
         Op::I2c,
+        Op::AddFault,
     ];
 
     /// Whether it feeds bytes to the device (which may hold a Hello, resetting its counters).
@@ -202,6 +206,7 @@ impl Harness {
                     self.now_ns = self.now_ns.saturating_add(u64::from(step) << shift);
                 }
             }
+            Op::AddFault => self.add_fault(input),
             Op::Poll => {
                 self.poll();
             }
@@ -209,6 +214,85 @@ impl Harness {
             Op::I2c => self.i2c(input),
         }
         op
+    }
+
+    /// An AddFault: half the time a valid message of any kind with fuzzed parameters, else a
+    /// valid header (device, seed, window, kind code up to one past the last) followed by any
+    /// bytes, so the parser's refusals are reached too.
+    fn add_fault(&mut self, input: &mut Input<'_>) {
+        let device = input.u8() % 4;
+        let seed = input.u64();
+        let start_ns = input.u64() % 10_000_000_000;
+        let end_ns = start_ns.saturating_add(u64::from(input.u32()));
+        if input.u8() & 1 == 0 {
+            let f = |input: &mut Input<'_>| f32::from_bits(input.u32());
+            let sensor = [Sensor::Acc, Sensor::Gyr, Sensor::Mag][usize::from(input.u8() % 3)];
+            let kind = match input.u8() % 18 {
+                0 => FaultKind::Stuck { sensor },
+                1 => FaultKind::StuckAt {
+                    sensor,
+                    value: [f(input), f(input), f(input)],
+                },
+                2 => FaultKind::Dropout { sensor },
+                3 => FaultKind::Spikes {
+                    sensor,
+                    rate_hz: f(input),
+                    amplitude: f(input),
+                    axes: input.u8() & 7,
+                },
+                4 => FaultKind::BiasStep {
+                    sensor,
+                    bias: [f(input), f(input), f(input)],
+                },
+                5 => FaultKind::Scale {
+                    sensor,
+                    factor: [f(input), f(input), f(input)],
+                },
+                6 => FaultKind::Noise {
+                    sensor,
+                    std: [f(input), f(input), f(input)],
+                },
+                7 => FaultKind::MagSaturation {
+                    field: [f(input), f(input), f(input)],
+                },
+                8 => FaultKind::Reset,
+                9 => FaultKind::WrongIdentity { value: input.u8() },
+                10 => FaultKind::FifoOverflow,
+                11 => FaultKind::Nak,
+                12 => FaultKind::Corrupt {
+                    probability: f(input),
+                },
+                13 => FaultKind::ClockStretch {
+                    stretch_ns: input.u32(),
+                },
+                14 => FaultKind::ClockOffset {
+                    ppm: f(input),
+                    drift_ppm_per_s: f(input),
+                },
+                15 => FaultKind::DrdyJitter {
+                    max_ns: input.u32(),
+                },
+                16 => FaultKind::MissingDrdy {
+                    probability: f(input),
+                },
+                _ => FaultKind::Late {
+                    delay_ns: input.u32(),
+                },
+            };
+            let fault = Fault::new(device, Window::new(start_ns, end_ns), kind);
+            self.send(&Message::AddFault(AddFault { fault, seed }));
+        } else {
+            let mut payload = Vec::with_capacity(64);
+            payload.push(device);
+            payload.extend_from_slice(&seed.to_le_bytes());
+            payload.extend_from_slice(&start_ns.to_le_bytes());
+            payload.extend_from_slice(&end_ns.to_le_bytes());
+            payload.push(input.u8() % 19);
+            let n = usize::from(input.u8() % 48);
+            payload.extend_from_slice(input.bytes(n));
+            let seq = self.host_seq;
+            self.raw_frame(Kind::AddFault as u8, seq, &payload);
+        }
     }
 
     fn configure(&mut self, input: &mut Input<'_>) {

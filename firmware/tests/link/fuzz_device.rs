@@ -6,12 +6,18 @@ use proptest::prelude::*;
 #[path = "../../fuzz/device_ops.rs"]
 mod device_ops;
 
-/// Hello, Configure (MPU-9250 at 1 kHz), images 0..8, Start, time passes, polls and a burst.
+/// Hello, Configure (MPU-9250 at 1 kHz), images 0..8, a fault, Start, time passes, polls and a
+/// burst.
 fn streaming_seed() -> Vec<u8> {
     let mut s = vec![2, 0, 1, 0, 0, 0]; // Hello, this version, session 1
     s.extend([3, 0, 0xE8, 0x03, 0, 0, 0, 0, 0, 0]); // Configure: MPU-9250, 1001/1 Hz
     s.extend([6, 0, 0, 0, 0, 0, 0, 0, 0, 8, 22]); // 8 images of 22 bytes from index 0
     s.extend((0..8 * 22).map(|i| i as u8));
+    // AddFault, a valid message: device 0, seed 7, from 0 for 5 ms, the gyroscope stuck.
+    s.extend([11, 0, 7, 0, 0, 0, 0, 0, 0, 0]);
+    s.extend([0; 8]);
+    s.extend(5_000_000u32.to_le_bytes());
+    s.extend([0, 1, 0]);
     s.extend([4, 0, 0, 0, 0, 0, 0, 0, 0, 63, 0, 0, 0, 0]); // Start until Stop at t0 = 0
     for _ in 0..12 {
         s.extend([7, 0x40, 0x42, 0x0F, 0x00, 0]); // +1 ms
