@@ -31,12 +31,13 @@ use super::{ChipModel, Conversion, Image};
 use crate::regmap::icm42688p::convert::{INVALID16, INVALID20};
 use crate::regmap::icm42688p::image::field as icm;
 use crate::regmap::mpu6xxx::image::field as mpu;
-use crate::regmap::{ak8963, rm3100};
+use crate::regmap::{ak8963, bmi088, bmi270, mag_image, rm3100};
 use core::ops::Range;
+use margemu_model::fault::Sensor;
 
-const ACC: u8 = 1;
-const GYR: u8 = 2;
-const MAG: u8 = 4;
+const ACC: u8 = Sensor::Acc.bit();
+const GYR: u8 = Sensor::Gyr.bit();
+const MAG: u8 = Sensor::Mag.bit();
 
 /// Writes the invalid values of `sensors` into `image`, an image of `model` under `conversion`.
 pub(super) fn mark(conversion: &Conversion, model: ChipModel, image: &mut Image, sensors: u8) {
@@ -68,13 +69,24 @@ pub(super) fn mark(conversion: &Conversion, model: ChipModel, image: &mut Image,
             each(bytes, acc, icm::ACCEL20, &be20);
             each(bytes, gyr, icm::GYRO20, &be20);
         }
-        Conversion::Bmi270(_) | Conversion::Bmi088(_) => {
-            // Both: ACC x, y, z then GYR/RATE x, y, z, LSB first.
-            each(bytes, acc, 0..6, &le16);
-            each(bytes, gyr, 6..12, &le16);
+        // Both Bosch images: ACC x, y, z then GYR/RATE x, y, z, LSB first.
+        Conversion::Bmi270(_) => {
+            each(bytes, acc, bmi270::image::field::ACCEL, &le16);
+            each(bytes, gyr, bmi270::image::field::GYRO, &le16);
         }
-        Conversion::Ist8310 | Conversion::Qmc5883l(_) => each(bytes, mag, 0..6, &le16),
-        Conversion::Rm3100(_) => each(bytes, mag, 0..9, &rm3100::data_bytes(-(1 << 23))),
+        Conversion::Bmi088(_) => {
+            each(bytes, acc, bmi088::image::field::ACCEL, &le16);
+            each(bytes, gyr, bmi088::image::field::GYRO, &le16);
+        }
+        Conversion::Ist8310 | Conversion::Qmc5883l(_) => {
+            each(bytes, mag, 0..mag_image::IMAGE_LEN, &le16)
+        }
+        Conversion::Rm3100(_) => each(
+            bytes,
+            mag,
+            0..rm3100::IMAGE_LEN,
+            &rm3100::data_bytes(-(1 << 23)),
+        ),
     }
 }
 
