@@ -17,7 +17,9 @@
 //! assert_eq!((s.quiet_until(25), s.quiet_until(35), s.quiet_until(45)), (Some(30), None, Some(u64::MAX)));
 //! ```
 
-use margemu_model::fault::{fault_rng, overlaps_exclusively, Fault, ScheduleFull, MAX_FAULTS};
+use margemu_model::fault::{
+    self, fault_rng, overlaps_exclusively, Fault, ScheduleFull, MAX_FAULTS,
+};
 use margemu_model::rng::StreamRng;
 
 /// One fault of the schedule.
@@ -106,17 +108,7 @@ impl FaultSchedule {
     /// starts at ([`UNTIL_END`](margemu_model::fault::UNTIL_END) if none does): until then the
     /// schedule does nothing.
     pub fn quiet_until(&self, t_ns: u64) -> Option<u64> {
-        let mut next = u64::MAX;
-        for e in &self.faults {
-            let w = &e.fault.window;
-            if w.contains(t_ns) {
-                return None;
-            }
-            if w.start_ns > t_ns {
-                next = next.min(w.start_ns);
-            }
-        }
-        Some(next)
+        fault::quiet_until(self.faults.iter().map(|e| &e.fault.window), t_ns)
     }
 
     /// Device `device`'s faults whose window holds `t_ns`.

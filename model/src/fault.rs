@@ -234,6 +234,28 @@ pub enum FaultKind {
     },
 }
 
+/// Every kind's name, in [`FaultKind`]'s declaration order ([`FaultKind::code`]).
+pub const KIND_NAMES: [&str; 18] = [
+    "stuck",
+    "stuck_at",
+    "dropout",
+    "spikes",
+    "bias_step",
+    "scale",
+    "noise",
+    "mag_saturation",
+    "reset",
+    "wrong_identity",
+    "fifo_overflow",
+    "nak",
+    "corrupt",
+    "clock_stretch",
+    "clock_offset",
+    "drdy_jitter",
+    "missing_drdy",
+    "late",
+];
+
 /// The four groups of [`FaultKind`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FaultClass {
@@ -248,27 +270,38 @@ pub enum FaultClass {
 }
 
 impl FaultKind {
-    /// Its name in scene files and `events.csv`.
-    pub const fn name(&self) -> &'static str {
+    /// Its position in declaration order: its index in [`KIND_NAMES`] and its wire code on the
+    /// link (`docs/spec/link.md` §5.16).
+    pub const fn code(&self) -> u8 {
         match self {
-            FaultKind::Stuck { .. } => "stuck",
-            FaultKind::StuckAt { .. } => "stuck_at",
-            FaultKind::Dropout { .. } => "dropout",
-            FaultKind::Spikes { .. } => "spikes",
-            FaultKind::BiasStep { .. } => "bias_step",
-            FaultKind::Scale { .. } => "scale",
-            FaultKind::Noise { .. } => "noise",
-            FaultKind::MagSaturation { .. } => "mag_saturation",
-            FaultKind::Reset => "reset",
-            FaultKind::WrongIdentity { .. } => "wrong_identity",
-            FaultKind::FifoOverflow => "fifo_overflow",
-            FaultKind::Nak => "nak",
-            FaultKind::Corrupt { .. } => "corrupt",
-            FaultKind::ClockStretch { .. } => "clock_stretch",
-            FaultKind::ClockOffset { .. } => "clock_offset",
-            FaultKind::DrdyJitter { .. } => "drdy_jitter",
-            FaultKind::MissingDrdy { .. } => "missing_drdy",
-            FaultKind::Late { .. } => "late",
+            FaultKind::Stuck { .. } => 0,
+            FaultKind::StuckAt { .. } => 1,
+            FaultKind::Dropout { .. } => 2,
+            FaultKind::Spikes { .. } => 3,
+            FaultKind::BiasStep { .. } => 4,
+            FaultKind::Scale { .. } => 5,
+            FaultKind::Noise { .. } => 6,
+            FaultKind::MagSaturation { .. } => 7,
+            FaultKind::Reset => 8,
+            FaultKind::WrongIdentity { .. } => 9,
+            FaultKind::FifoOverflow => 10,
+            FaultKind::Nak => 11,
+            FaultKind::Corrupt { .. } => 12,
+            FaultKind::ClockStretch { .. } => 13,
+            FaultKind::ClockOffset { .. } => 14,
+            FaultKind::DrdyJitter { .. } => 15,
+            FaultKind::MissingDrdy { .. } => 16,
+            FaultKind::Late { .. } => 17,
+        }
+    }
+
+    /// Its name in scene files and `events.csv` ([`KIND_NAMES`]).
+    pub const fn name(&self) -> &'static str {
+        let code = self.code() as usize;
+        if code < KIND_NAMES.len() {
+            KIND_NAMES[code]
+        } else {
+            ""
         }
     }
 
@@ -382,6 +415,21 @@ pub fn overlaps_exclusively(a: &Fault, b: &Fault) -> bool {
         && matches!((a.kind.exclusive_group(), b.kind.exclusive_group()), (Some(x), Some(y)) if x == y)
 }
 
+/// `None` if one of `windows` holds `t_ns`; else the first instant after `t_ns` at which one of
+/// them starts ([`UNTIL_END`] if none does): until then none of them is active.
+pub fn quiet_until<'a>(windows: impl IntoIterator<Item = &'a Window>, t_ns: u64) -> Option<u64> {
+    let mut next = UNTIL_END;
+    for w in windows {
+        if w.contains(t_ns) {
+            return None;
+        }
+        if w.start_ns > t_ns {
+            next = next.min(w.start_ns);
+        }
+    }
+    Some(next)
+}
+
 /// The random stream of fault `index` of a device whose seed is `seed` (see the module docs).
 pub fn fault_rng(seed: u64, index: usize) -> StreamRng {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -470,21 +518,12 @@ impl SensorFaults {
             self.last = *sample;
             return 0;
         }
-        let mut active = false;
-        let mut next_start = u64::MAX;
-        for (fault, _, _) in &self.faults {
-            if fault.kind.class() != FaultClass::Sensor {
-                continue;
-            }
-            if fault.window.contains(t_ns) {
-                active = true;
-                break;
-            }
-            if fault.window.start_ns > t_ns {
-                next_start = next_start.min(fault.window.start_ns);
-            }
-        }
-        if !active {
+        let sensor_windows = self
+            .faults
+            .iter()
+            .filter(|(f, _, _)| f.kind.class() == FaultClass::Sensor)
+            .map(|(f, _, _)| &f.window);
+        if let Some(next_start) = quiet_until(sensor_windows, t_ns) {
             (self.idle_from, self.idle_until) = (t_ns, next_start);
             self.held = [None; 3];
             self.last = *sample;

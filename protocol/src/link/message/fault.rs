@@ -34,28 +34,10 @@ pub struct AddFault {
 /// Bytes before the kind's parameters: device, seed, start, end, kind code.
 const FIXED_LEN: usize = 1 + 8 + 8 + 8 + 1;
 
-/// The wire code of each kind, in `FaultKind`'s order (`docs/spec/link.md` §5.16).
+/// The wire code of each kind: its position in `FaultKind`'s order ([`FaultKind::code`];
+/// `docs/spec/link.md` §5.16).
 pub fn kind_code(kind: &FaultKind) -> u8 {
-    match kind {
-        FaultKind::Stuck { .. } => 0,
-        FaultKind::StuckAt { .. } => 1,
-        FaultKind::Dropout { .. } => 2,
-        FaultKind::Spikes { .. } => 3,
-        FaultKind::BiasStep { .. } => 4,
-        FaultKind::Scale { .. } => 5,
-        FaultKind::Noise { .. } => 6,
-        FaultKind::MagSaturation { .. } => 7,
-        FaultKind::Reset => 8,
-        FaultKind::WrongIdentity { .. } => 9,
-        FaultKind::FifoOverflow => 10,
-        FaultKind::Nak => 11,
-        FaultKind::Corrupt { .. } => 12,
-        FaultKind::ClockStretch { .. } => 13,
-        FaultKind::ClockOffset { .. } => 14,
-        FaultKind::DrdyJitter { .. } => 15,
-        FaultKind::MissingDrdy { .. } => 16,
-        FaultKind::Late { .. } => 17,
-    }
+    kind.code()
 }
 
 /// Bytes of a kind's parameters.

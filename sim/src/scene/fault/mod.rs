@@ -86,27 +86,7 @@ pub struct FaultSpec {
     pub delay: Option<f64>,
 }
 
-/// Every kind's name, in [`FaultKind`] order.
-pub const KIND_NAMES: [&str; 18] = [
-    "stuck",
-    "stuck_at",
-    "dropout",
-    "spikes",
-    "bias_step",
-    "scale",
-    "noise",
-    "mag_saturation",
-    "reset",
-    "wrong_identity",
-    "fifo_overflow",
-    "nak",
-    "corrupt",
-    "clock_stretch",
-    "clock_offset",
-    "drdy_jitter",
-    "missing_drdy",
-    "late",
-];
+use margemu_model::fault::KIND_NAMES;
 
 /// The parameters kind `kind` takes (required first, then `optional` ones).
 fn params_of(kind: &str) -> (&'static [&'static str], &'static [&'static str]) {
