@@ -24,22 +24,11 @@ mod common;
 #[path = "../tests/common/ekf_reference.rs"]
 mod ekf_reference;
 
-use common::{widen, Scene};
+use common::{bench_samples, widen, BENCH_SAMPLES as SAMPLES};
 use criterion::{criterion_group, criterion_main, Criterion};
 use ekf_reference::ReferenceEkf;
 use margemu_filters::{AttitudeFilter, Ecf, EcfConfig, Ekf, EkfConfig, Gda, GdaConfig, Imu, Real};
 use std::hint::black_box;
-
-const SAMPLES: usize = 4096;
-
-fn samples() -> Vec<Imu<f32>> {
-    let mut scene = Scene::new(200.0, 3);
-    // Skip the first seconds so that bursts and accelerations are under way.
-    (0..2000 + SAMPLES)
-        .map(|_| scene.next().1)
-        .skip(2000)
-        .collect()
-}
 
 fn bench_filter<T: Real, F: AttitudeFilter<T>>(
     c: &mut Criterion,
@@ -85,7 +74,7 @@ macro_rules! baseline {
 }
 
 fn bench(c: &mut Criterion) {
-    let single = samples();
+    let single = bench_samples();
     let double: Vec<Imu<f64>> = single.iter().map(widen).collect();
     if let Some(path) = std::env::var_os("MARGEMU_BENCH_SAMPLES") {
         let mut text = String::new();

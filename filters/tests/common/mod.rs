@@ -144,3 +144,16 @@ pub fn widen(imu: &Imu<f32>) -> Imu<f64> {
         mag: w(imu.mag),
     }
 }
+
+/// Samples the benchmarks replay (`benches/`): the paper-like scene at 200 Hz, seed 3, after
+/// its first 2000 samples (so that bursts and accelerations are under way).
+pub const BENCH_SAMPLES: usize = 4096;
+
+/// The [`BENCH_SAMPLES`] samples of the benchmarks.
+pub fn bench_samples() -> Vec<Imu<f32>> {
+    let mut scene = Scene::new(200.0, 3);
+    (0..2000 + BENCH_SAMPLES)
+        .map(|_| scene.next().1)
+        .skip(2000)
+        .collect()
+}
