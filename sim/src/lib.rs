@@ -5,7 +5,7 @@
 //!
 //! Layers, bottom up:
 //! - [`input_file`]: every file a scene or a command reads is a regular file of bounded size;
-//!   [`csv_column`]: named numeric columns of CSV files;
+//!   [`csv_column`]: named numeric columns of CSV files; [`csv_row`]: the rows margemu writes;
 //! - [`scene`]: the TOML scene file, validated with errors that point at file, line and column;
 //! - [`reference`](mod@reference): each joint's reference signal (steps, waypoints, sines, random, CSV);
 //! - [`bench`](mod@bench): the closed-loop bench (eq. 5–17): joints, friction, PID synthesis, integrators;
@@ -26,6 +26,7 @@
 
 pub mod bench;
 pub mod csv_column;
+pub mod csv_row;
 pub mod csv_table;
 pub mod fault_log;
 pub mod filter_params;

@@ -18,6 +18,7 @@
 //! the scene's field unit (`NaN` for a sensor in a dropout window). `perturbation.csv`: `t_ns,mag_x,mag_y,mag_z`, the disturbance added
 //! to the true field per axis (written only when the scene has a `[perturbation]`).
 
+use crate::csv_row::{self, RowBuf};
 use crate::sampling::HostFront;
 use crate::scene::chip::ChipSetup;
 use crate::scene::vibration::DeviceVibration;
@@ -262,41 +263,38 @@ pub fn sensor_faults(scene: &Scene, index: usize, seed: u64, rate_hz: f64) -> Op
     (!faults.is_empty()).then_some(faults)
 }
 
-/// Writes `marg.csv` rows (and optionally `perturbation.csv` rows).
+/// Writes `marg.csv` rows (and optionally `perturbation.csv` rows), one `write_all` per row
+/// ([`crate::csv_row`]).
 pub struct MargWriter<W: Write> {
     marg: W,
     perturbation: Option<W>,
-    float: ryu::Buffer,
+    row: RowBuf,
 }
 
 impl<W: Write> MargWriter<W> {
     /// Writes the headers.
     pub fn new(mut marg: W, mut perturbation: Option<W>) -> io::Result<Self> {
-        writeln!(marg, "{}", MARG_COLUMNS.join(","))?;
+        marg.write_all(csv_row::header(&MARG_COLUMNS).as_bytes())?;
         if let Some(p) = perturbation.as_mut() {
-            writeln!(p, "{}", PERTURBATION_COLUMNS.join(","))?;
+            p.write_all(csv_row::header(&PERTURBATION_COLUMNS).as_bytes())?;
         }
         Ok(Self {
             marg,
             perturbation,
-            float: ryu::Buffer::new(),
+            row: RowBuf::default(),
         })
     }
 
     /// Writes one sample.
     pub fn write(&mut self, s: &MargSample) -> io::Result<()> {
         if s.dropout == 0 {
-            write_row(&mut self.marg, &mut self.float, s.t_ns, s.values())?;
+            self.row
+                .write(&mut self.marg, s.t_ns, s.values().copied())?;
         } else {
-            write_row(
-                &mut self.marg,
-                &mut self.float,
-                s.t_ns,
-                s.written_values().iter(),
-            )?;
+            self.row.write(&mut self.marg, s.t_ns, s.written_values())?;
         }
         if let Some(p) = self.perturbation.as_mut() {
-            write_row(p, &mut self.float, s.t_ns, s.disturbance.iter())?;
+            self.row.write(p, s.t_ns, s.disturbance)?;
         }
         Ok(())
     }
@@ -309,18 +307,4 @@ impl<W: Write> MargWriter<W> {
         }
         Ok(())
     }
-}
-
-fn write_row<'a>(
-    out: &mut impl Write,
-    float: &mut ryu::Buffer,
-    t_ns: u64,
-    values: impl Iterator<Item = &'a f32>,
-) -> io::Result<()> {
-    write!(out, "{t_ns}")?;
-    for v in values {
-        out.write_all(b",")?;
-        out.write_all(float.format(*v).as_bytes())?;
-    }
-    out.write_all(b"\n")
 }

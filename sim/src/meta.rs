@@ -377,13 +377,13 @@ impl Appended<'_> {
     }
 }
 
-/// Appends `table` to `dir/meta.toml` and syncs it to the disk.
+/// Appends `table` to `dir/meta.toml` in one write. It is not synced to the disk, like every
+/// other file of a run directory ([`crate::rundir`], "Completion record").
 pub fn append(dir: &Path, table: Appended<'_>) -> io::Result<()> {
     let mut meta = std::fs::OpenOptions::new()
         .append(true)
         .open(dir.join(META_FILE))?;
-    meta.write_all(table.to_toml().as_bytes())?;
-    meta.sync_all()
+    meta.write_all(table.to_toml().as_bytes())
 }
 
 #[cfg(test)]

@@ -16,9 +16,10 @@
 //! | `dwx,dwy,dwz` | body angular acceleration (rad/s²) |
 //! | `mx,my,mz` | true magnetic field, body frame (scene unit) |
 //!
-//! Floats are written in their shortest round-trip form, so files are exact and byte-identical
+//! Floats are written in their shortest round-trip form ([`crate::csv_row`]), so files are exact and byte-identical
 //! for the same scene and seed. `meta.toml` holds no wall-clock time for the same reason.
 
+use crate::csv_row::{self, RowBuf};
 use crate::truth::Truth;
 use std::io::{self, Write};
 
@@ -36,42 +37,25 @@ pub const TRUTH_COLUMNS: [&str; 32] = [
     "dwz", "mx", "my", "mz",
 ];
 
-/// Writes truth rows as CSV.
+/// Writes truth rows as CSV ([`crate::csv_row`]: one `write_all` per row).
 pub struct TruthWriter<W: Write> {
     out: W,
-    float: ryu::Buffer,
+    row: RowBuf,
 }
 
 impl<W: Write> TruthWriter<W> {
     /// Writes the header and returns the writer.
     pub fn new(mut out: W) -> io::Result<Self> {
-        writeln!(out, "{}", TRUTH_COLUMNS.join(","))?;
+        out.write_all(csv_row::header(&TRUTH_COLUMNS).as_bytes())?;
         Ok(Self {
             out,
-            float: ryu::Buffer::new(),
+            row: RowBuf::default(),
         })
     }
 
     /// Writes one row.
     pub fn write(&mut self, t: &Truth) -> io::Result<()> {
-        write!(self.out, "{}", t.t_ns)?;
-        let groups: [&[f64]; 10] = [
-            &t.position,
-            &t.euler,
-            &t.quaternion,
-            &t.body_rate,
-            &t.specific_force,
-            &t.velocity,
-            &t.accel_world,
-            &t.accel_body,
-            &t.angular_accel,
-            &t.field_body,
-        ];
-        for v in groups.iter().flat_map(|g| g.iter()) {
-            self.out.write_all(b",")?;
-            self.out.write_all(self.float.format(*v).as_bytes())?;
-        }
-        self.out.write_all(b"\n")
+        self.row.write(&mut self.out, t.t_ns, row_values(t))
     }
 
     /// Flushes the inner writer.
@@ -84,6 +68,23 @@ impl<W: Write> TruthWriter<W> {
         self.out.flush()?;
         Ok(self.out)
     }
+}
+
+/// The values of a truth row after `t_ns`, in [`TRUTH_COLUMNS`]' order.
+fn row_values(t: &Truth) -> impl Iterator<Item = f64> + '_ {
+    let groups: [&[f64]; 10] = [
+        &t.position,
+        &t.euler,
+        &t.quaternion,
+        &t.body_rate,
+        &t.specific_force,
+        &t.velocity,
+        &t.accel_world,
+        &t.accel_body,
+        &t.angular_accel,
+        &t.field_body,
+    ];
+    groups.into_iter().flatten().copied()
 }
 
 #[cfg(test)]

@@ -71,7 +71,7 @@ impl fmt::Display for Completion {
     }
 }
 
-/// Appends the `[completion]` table to `dir/meta.toml` and syncs it to the disk.
+/// Appends the `[completion]` table to `dir/meta.toml` (not synced: [`crate::rundir`]).
 pub fn write_completion(dir: &Path, completion: &Completion) -> io::Result<()> {
     crate::meta::append(dir, Appended::Completion(completion))
 }

@@ -23,6 +23,11 @@
 //! ended = "completed"        # why the run ended, in words
 //! ```
 //!
+//! The record, like the data files, is written and closed but not synced to the disk: it tells
+//! runs that ended, were stopped or were killed apart, and makes no claim about a power loss
+//! (syncing the record alone would not make one, since the rows it counts are not synced, and it
+//! cost a `simulate` of a few milliseconds more than the rest of the run).
+//!
 //! A `meta.toml` with `margemu_version` but no `[completion]` table belongs to a run that was
 //! killed (or is still running). [`check_complete`] is what `evaluate` asks before reading a
 //! directory. Directories whose `meta.toml` has no `margemu_version` were not written by margemu
