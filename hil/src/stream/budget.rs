@@ -58,6 +58,18 @@ pub struct BudgetPolicy {
     pub over_budget: bool,
 }
 
+impl BudgetPolicy {
+    /// For a device the host runs itself: [`BoardKind::Auto`] becomes
+    /// [`BoardKind::Loopback`] (an explicit board is kept, to try a board's budget).
+    pub fn in_process(self) -> Self {
+        let board = match self.board {
+            BoardKind::Auto => BoardKind::Loopback,
+            b => b,
+        };
+        Self { board, ..self }
+    }
+}
+
 /// The real board behind `kind` and the HelloAck's `device_id`; `None` for QEMU and host-run
 /// devices.
 pub fn board_of(kind: BoardKind, device_id: &[u8]) -> Option<Board> {
