@@ -58,7 +58,8 @@ pub const COST_EQ18: f64 = 1010.0;
 pub const COST_OTHER_TERMS: f64 = 2100.0;
 /// The magnetic perturbation per axis, per output sample: three burst shapings (FFTs in
 /// software `f64`) per 2 s window, averaged (measured: 45 900 at 1 kHz to 54 900 at 8 kHz).
-/// A burst's shaping runs at its first sample: a spike of about 3·10⁸ instructions at 8 kHz.
+/// A burst's shaping runs at its first sample: a spike of about 3·10⁸ instructions per axis
+/// at 8 kHz.
 pub const COST_PERTURBATION: f64 = 55_000.0;
 /// Per sensor and internal sample on the chip's internal path (its filters and clipping).
 pub const COST_INTERNAL_STEP: f64 = 560.0;
