@@ -60,7 +60,7 @@ pub const DURATION_NS: u64 = 2_000_000_000;
 pub const SEED: u64 = 0x6d61_7267_6d6f_6431;
 /// µT per unit of the cases' normalised field.
 pub const MAG_UT_PER_UNIT: f64 = 50.0;
-/// The field in world axes, normalised units (`docs/../CONVENTIONS`: north, 56° down).
+/// The field in world axes, normalised units (the conventions' reference field, 56° down).
 const FIELD_W: [f32; 3] = [0.5, 0.0, -0.83];
 
 /// `Complex` scratch values the largest perturbation case needs (2 s at 8 kHz: a window of
