@@ -198,7 +198,7 @@ pub fn harness(samples: u32, period_ns: u64, clock: &mut impl FnMut() -> u64) ->
 /// The synthetic truth: the body turning about its y axis at [`Motion::RATE`] through gravity
 /// (the rotation advanced by a fixed `f32` rotation per sample, no transcendental function in
 /// the loop), with a small roll rate following the same angle.
-struct Motion {
+pub(crate) struct Motion {
     cos: f32,
     sin: f32,
     step_cos: f32,
@@ -209,9 +209,9 @@ impl Motion {
     /// Pitch rate, rad/s.
     const RATE: f32 = 2.0;
     /// Standard gravity, m/s².
-    const G: f32 = 9.806_65;
+    pub(crate) const G: f32 = 9.806_65;
 
-    fn new(period_ns: u64) -> Self {
+    pub(crate) fn new(period_ns: u64) -> Self {
         let step = f64::from(Self::RATE) * period_ns as f64 * 1e-9;
         Self {
             cos: 1.0,
@@ -221,7 +221,7 @@ impl Motion {
         }
     }
 
-    fn next(&mut self) -> Truth {
+    pub(crate) fn next(&mut self) -> Truth {
         let (c, s) = (self.cos, self.sin);
         let truth = Truth {
             angular_rate: [0.25 * s, Self::RATE, 0.1 * c],
@@ -235,22 +235,26 @@ impl Motion {
 }
 
 /// 64-bit FNV-1a, fed incrementally.
-struct Fnv1a(u64);
+pub(crate) struct Fnv1a(u64);
 
 impl Fnv1a {
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self(0xcbf2_9ce4_8422_2325)
     }
 
-    fn write_vec(&mut self, v: Vec3) {
+    pub(crate) fn write_vec(&mut self, v: Vec3) {
         for x in v {
-            for b in x.to_bits().to_le_bytes() {
-                self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
-            }
+            self.write(&x.to_bits().to_le_bytes());
         }
     }
 
-    fn finish(&self) -> u64 {
+    pub(crate) fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+
+    pub(crate) fn finish(&self) -> u64 {
         self.0
     }
 }

@@ -198,7 +198,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
                 host: PROTOCOL_VERSION,
             });
         }
-        if let Some(reason) = self.session.refusal(&ack.capabilities) {
+        if let Some(reason) = self.session.refusal(&ack) {
             return Err(StreamError::Unsupported { reason });
         }
         let device = device_meta(&ack);

@@ -76,6 +76,7 @@
 //! ([`log`], written by their own thread) are flushed and end with an `end` row in
 //! `events.csv`.
 
+pub mod budget;
 pub mod clipping;
 pub mod clock;
 pub mod device_truth;

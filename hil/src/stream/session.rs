@@ -3,6 +3,7 @@
 //! the items and their lazy prediction) and the log writer (`logger.rs`), and hands itself to
 //! the run (`flow.rs`), which reaches them only through the session's methods.
 
+use super::budget::{board_of, budget_refusal, scene_load, BudgetPolicy};
 use super::clock::SystemClock;
 use super::flow::Run;
 use super::images::{predict_images, ImageSettings};
@@ -16,7 +17,8 @@ use super::port::{Port, SystemPort};
 use super::served::ServedCheck;
 use super::source::{Items, Prediction, Source};
 use super::{Progress, StreamError, Summary};
-use margemu_protocol::link::{Capabilities, Configure, Encoder, HelloAck, Rate};
+use margemu_firmware::budget::Load;
+use margemu_protocol::link::{Configure, Encoder, HelloAck, Rate};
 use margemu_sim::rundir::{Completion, CompletionRecord, Status};
 use margemu_sim::scene::Scene;
 use std::io::{Read, Write};
@@ -76,6 +78,9 @@ pub struct StreamConfig {
     /// Also write `session.mcap` (ROS 2 messages for Foxglove and `ros2 bag`), on the log
     /// writer thread with the CSV files.
     pub mcap: bool,
+    /// Source mode (b) on a real board: which board, and whether to stream beyond its budget
+    /// ([`budget`](super::budget)).
+    pub budget: BudgetPolicy,
 }
 
 impl Default for StreamConfig {
@@ -95,6 +100,7 @@ impl Default for StreamConfig {
             session_id: 0x6D61_7267, // "marg"
             resend_after: Duration::from_millis(20),
             mcap: false,
+            budget: BudgetPolicy::default(),
         }
     }
 }
@@ -112,6 +118,8 @@ pub struct Session {
     stop: Arc<AtomicBool>,
     /// Host time 0 of the logs; `None`: when the run begins.
     origin: Option<Instant>,
+    /// Source mode (b): what the device runs per output sample, and the output rate, Hz.
+    load: Option<(Load, f64)>,
 }
 
 impl Session {
@@ -144,6 +152,10 @@ impl Session {
             }
         };
         prediction.check_start()?;
+        let load = match config.source {
+            SourceMode::Images => None,
+            SourceMode::Model { .. } => Some((scene_load(scene, rate)?, rate.as_hz_f64())),
+        };
         let meta = metadata(scene, &config, &settings, rate, hold);
         let log_err = |source| StreamError::Log {
             path: dir.to_path_buf(),
@@ -184,6 +196,7 @@ impl Session {
             log,
             stop: Arc::new(AtomicBool::new(false)),
             origin: None,
+            load,
         })
     }
 
@@ -239,9 +252,14 @@ impl Session {
         Plan::new(&self.source, &self.config, ack)
     }
 
-    /// Why a device with capabilities `caps` cannot serve this session (`None`: it can).
-    pub(super) fn refusal(&self, caps: &Capabilities) -> Option<String> {
-        self.source.refusal(caps)
+    /// Why the device that answered `ack` cannot serve this session (`None`: it can): its
+    /// capabilities, or in source mode (b) a real board's budget ([`budget_refusal`]).
+    pub(super) fn refusal(&self, ack: &HelloAck) -> Option<String> {
+        self.source.refusal(&ack.capabilities).or_else(|| {
+            let (load, rate_hz) = self.load.as_ref()?;
+            let board = board_of(self.config.budget.board, &ack.device_id)?;
+            budget_refusal(&self.config.budget, &board, &ack.device_id, load, *rate_hz)
+        })
     }
 
     /// One AddDevice per other device of a rig, to follow Configure.

@@ -54,6 +54,7 @@ impl Cmd {
             port: label.clone(),
             images: Some(settings),
             source: self.source.mode()?,
+            budget: self.source.budget().in_process(),
             mcap: self.mcap,
             ..StreamConfig::default()
         };

@@ -6,6 +6,7 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use margemu::dut::{open_dut_port, DutConfig, DutProtocol, DutSummary};
 use margemu::scene::Scene;
+use margemu::stream::budget::{BoardKind, BudgetPolicy};
 use margemu::stream::{open_port, Progress, Session, SourceMode, StreamConfig};
 use margemu::vfc::{attach, AttachedDut};
 use std::path::{Path, PathBuf};
@@ -113,6 +114,24 @@ pub struct SourceArgs {
     /// (default: the output rate / max(2, ceil(rate / 1000 Hz))).
     #[arg(long, value_name = "HZ")]
     kinematics_rate: Option<f64>,
+    /// The device, for source mode (b)'s budget: `auto` (from the device ID it reports: the
+    /// QEMU board and host-run devices are not budgeted, any other is taken for the Black Pill),
+    /// `blackpill-f411`, `qemu` or `loopback`.
+    #[arg(long, value_enum, default_value_t = Board::Auto)]
+    board: Board,
+    /// Stream a source mode (b) scene even beyond a real board's budget (the device may fall
+    /// behind and underrun).
+    #[arg(long)]
+    over_budget: bool,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Board {
+    Auto,
+    #[value(name = "blackpill-f411")]
+    BlackpillF411,
+    Qemu,
+    Loopback,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -137,6 +156,19 @@ impl SourceArgs {
             }),
         }
     }
+
+    /// Source mode (b)'s budget policy: `--board` and `--over-budget`.
+    pub fn budget(&self) -> BudgetPolicy {
+        BudgetPolicy {
+            board: match self.board {
+                Board::Auto => BoardKind::Auto,
+                Board::BlackpillF411 => BoardKind::BlackpillF411,
+                Board::Qemu => BoardKind::Qemu,
+                Board::Loopback => BoardKind::Loopback,
+            },
+            over_budget: self.over_budget,
+        }
+    }
 }
 
 impl Cmd {
@@ -159,6 +191,7 @@ impl Cmd {
             baud: self.baud,
             images: Some(images),
             source: self.source.mode()?,
+            budget: self.source.budget(),
             lead: Duration::from_secs_f64(self.lead_ms / 1000.0),
             batch,
             resend_after: resend_after(batch, self.baud),
