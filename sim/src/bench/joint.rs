@@ -23,6 +23,7 @@
 //! **Setpoint smoothing.** Optionally `q_d` is the output of `r̈_f = ωn² (r − r_f) − 2ζωn ṙ_f`
 //! driven by the raw reference `r`, integrated with the joint.
 
+use super::linear::{LinearStep, PlainRows};
 use super::pid::Gains;
 use crate::scene::Method;
 
@@ -45,11 +46,11 @@ pub struct JointParams {
     pub smoothing: Option<(f64, f64)>,
 }
 
-const Q: usize = 0;
-const V: usize = 1;
-const I: usize = 2;
-const RF: usize = 3;
-const RFD: usize = 4;
+pub(super) const Q: usize = 0;
+pub(super) const V: usize = 1;
+pub(super) const I: usize = 2;
+pub(super) const RF: usize = 3;
+pub(super) const RFD: usize = 4;
 
 /// Integrated state: position, velocity, error integral, smoothed setpoint and its rate.
 pub type State = [f64; 5];
@@ -70,37 +71,6 @@ pub struct Joint {
     state: State,
     stuck: bool,
     linear: Option<LinearStep>,
-}
-
-/// The step map of a linear joint for one method and step length.
-///
-/// Without stiction and without an effort limit a joint is linear and time-invariant,
-/// `ẋ = A x + b r(t)`, and one RK4 (or semi-implicit Euler) step is exactly linear in the state
-/// and the three reference samples: `x₁ = Φ x₀ + g₀ r₀ + g_m r_m + g₁ r₁`. The matrices are
-/// found by running the general step on unit inputs, so the fast path is the same method, not
-/// an approximation of it; only the rounding differs.
-#[derive(Clone, Debug)]
-struct LinearStep {
-    method: Method,
-    h: f64,
-    phi: [State; 5],
-    g: [State; 3],
-}
-
-impl LinearStep {
-    fn apply(&self, x: &State, r: [f64; 3]) -> State {
-        std::array::from_fn(|i| {
-            let row = &self.phi[i];
-            row[0] * x[0]
-                + row[1] * x[1]
-                + row[2] * x[2]
-                + row[3] * x[3]
-                + row[4] * x[4]
-                + self.g[0][i] * r[0]
-                + self.g[1][i] * r[1]
-                + self.g[2][i] * r[2]
-        })
-    }
 }
 
 /// Efforts at one state.
@@ -150,7 +120,18 @@ impl Joint {
             let r: [f64; 3] = std::array::from_fn(|m| if m == k { 1.0 } else { 0.0 });
             probe([0.0; 5], r)
         });
-        self.linear = Some(LinearStep { method, h, phi, g });
+        let plain = if self.params.smoothing.is_none() {
+            PlainRows::of(&phi, &g, &self.state)
+        } else {
+            None
+        };
+        self.linear = Some(LinearStep {
+            method,
+            h,
+            phi,
+            g,
+            plain,
+        });
     }
 
     /// The joint's parameters.
@@ -184,7 +165,7 @@ impl Joint {
 
     /// Acceleration at the current state with raw reference `r`.
     pub fn acceleration(&self, r: f64) -> f64 {
-        self.deriv(&self.state, r)[V]
+        self.accel(&self.state, self.effort(&self.state, r).net)
     }
 
     /// Net actuator effort `τ_a − V` at the current state with raw reference `r`.
@@ -206,14 +187,20 @@ impl Joint {
         }
     }
 
+    /// `q̈` at state `s` under net effort `net` (zero while stuck).
+    fn accel(&self, s: &State, net: f64) -> f64 {
+        if self.stuck {
+            0.0
+        } else {
+            (net - self.params.viscous * s[V]) / self.params.mass
+        }
+    }
+
     fn deriv(&self, s: &State, r: f64) -> State {
         let p = &self.params;
         let effort = self.effort(s, r);
-        let (dq, dv) = if self.stuck {
-            (0.0, 0.0)
-        } else {
-            (s[V], (effort.net - p.viscous * s[V]) / p.mass)
-        };
+        let dq = if self.stuck { 0.0 } else { s[V] };
+        let dv = self.accel(s, effort.net);
         let di = if effort.hold_integral {
             0.0
         } else {
@@ -228,7 +215,20 @@ impl Joint {
 
     /// Advances by `h` seconds with the raw reference at the start, middle and end of the step.
     /// Returns the friction mode change, if any.
+    #[inline]
     pub fn step(&mut self, method: Method, h: f64, r: [f64; 3]) -> Option<FrictionChange> {
+        // A prepared linear joint has no stiction, so no friction mode to decide.
+        if let Some(l) = &self.linear {
+            if l.h == h && l.method == method {
+                self.state = l.apply(&self.state, r);
+                return None;
+            }
+        }
+        self.step_general(method, h, r)
+    }
+
+    /// [`Self::step`] for a joint that may stick, or a step of another length.
+    fn step_general(&mut self, method: Method, h: f64, r: [f64; 3]) -> Option<FrictionChange> {
         let stiction = self.params.stiction;
         let mut change = None;
         if self.stuck && self.effort(&self.state, r[0]).net.abs() > stiction {
@@ -236,10 +236,7 @@ impl Joint {
             change = Some(FrictionChange::Slip);
         }
         let v_before = self.state[V];
-        self.state = match &self.linear {
-            Some(l) if l.h == h && l.method == method => l.apply(&self.state, r),
-            _ => self.advance(method, h, r),
-        };
+        self.state = self.advance(method, h, r);
         if stiction > 0.0 && !self.stuck {
             let v = self.state[V];
             let crossed = v_before * v < 0.0 || v == 0.0;
@@ -365,6 +362,48 @@ mod tests {
             stuck.prepare(method, 1e-3);
             assert!(stuck.linear.is_none());
         }
+    }
+
+    #[test]
+    fn the_plain_rows_give_the_full_product_bit_for_bit() {
+        let mut p = params(0.0);
+        p.gains = Gains {
+            kp: 5e5,
+            ki: 1.7e6,
+            kd: 5e4,
+        };
+        for (method, q0) in [
+            (Method::Rk4, 0.0),
+            (Method::Rk4, -0.0),
+            (Method::Rk4, 1.0),
+            (Method::SemiImplicitEuler, -2.5),
+        ] {
+            let mut j = Joint::new(p, q0);
+            j.prepare(method, 1e-3);
+            let map = j.linear.clone().expect("a linear joint");
+            assert!(map.plain.is_some(), "{method:?}: no plain rows");
+            // Zeros of both signs, tiny and large values, in every state and input slot.
+            let values = [0.0, -0.0, 1e-300, -3.5, 0.25, 7e12, -1e-9];
+            let mut x = j.state;
+            for k in 0..2000usize {
+                let pick = |n: usize| values[(k * 7 + n * 3 + k / 7) % values.len()];
+                let (x_q, x_v, x_i) = (pick(0), pick(1), pick(2));
+                let r = [pick(3), pick(4), pick(5)];
+                let probe = [x_q, x_v, x_i, x[RF], x[RFD]];
+                let (fast, full) = (map.apply(&probe, r), map.apply_full(&probe, r));
+                assert_eq!(
+                    fast.map(f64::to_bits),
+                    full.map(f64::to_bits),
+                    "{probe:?} {r:?}"
+                );
+                x = full;
+            }
+        }
+        // A smoothed joint moves its setpoint states, so it keeps the full product.
+        p.smoothing = Some((46.0, 0.869));
+        let mut j = Joint::new(p, 0.0);
+        j.prepare(Method::Rk4, 1e-3);
+        assert!(j.linear.expect("a linear joint").plain.is_none());
     }
 
     #[test]

@@ -18,6 +18,7 @@
 //! ```
 
 pub mod joint;
+mod linear;
 pub mod pid;
 mod pid_table;
 
@@ -197,11 +198,7 @@ impl Bench {
         for (i, (joint, reference)) in self.joints.iter_mut().zip(&mut self.references).enumerate()
         {
             let r = match self.method {
-                Method::Rk4 => [
-                    reference.value(t0),
-                    reference.value(0.5 * (t0 + t1)),
-                    reference.value_before(t1),
-                ],
+                Method::Rk4 => reference.step_values(t0, t1),
                 Method::SemiImplicitEuler => [reference.value(t0); 3],
             };
             if let Some(change) = joint.step(self.method, h, r) {

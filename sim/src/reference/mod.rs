@@ -174,6 +174,21 @@ impl Reference {
         }
     }
 
+    /// `[value(t0), value(½(t0 + t1)), value_before(t1)]`, the three samples an RK4 step from
+    /// `t0` to `t1 > t0` takes, with the same results; a held stretch of a piecewise source is
+    /// looked up once for all three.
+    pub fn step_values(&mut self, t0: f64, t1: f64) -> [f64; 3] {
+        let mid = 0.5 * (t0 + t1);
+        if let Kind::Piecewise(p) = &mut self.kind {
+            let known = (self.memo.0 == t0).then_some(self.memo.1);
+            if let Some(values) = p.span_values(t0, mid, t1, known) {
+                self.memo = (t1, values[2]);
+                return values;
+            }
+        }
+        [self.value(t0), self.value(mid), self.value_before(t1)]
+    }
+
     /// The value and its first two time derivatives at `t_ns` (kinematic mode).
     ///
     /// Held setpoints report zero derivatives; a linear CSV reports its slope.
@@ -221,6 +236,63 @@ fn polynomial_derivatives(c: &[f64], t: f64) -> Derivatives {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn step_values_are_the_three_separate_queries() {
+        let specs = [
+            SourceSpec::Steps {
+                points: vec![[0.1, 1.5], [0.1005, 1.0], [0.25, -2.0]],
+                smoothing: None,
+            },
+            SourceSpec::RandomSetpoints {
+                range: [-1.0, 1.0],
+                hold: [0.01, 0.03],
+                smoothing: None,
+            },
+            SourceSpec::RandomSine {
+                amplitude: [0.1, 0.9],
+                frequency: [0.5, 9.0],
+                segment: [0.01, 0.05],
+                offset: 0.2,
+            },
+            SourceSpec::Sine {
+                amplitude: 0.4,
+                frequency: 2.0,
+                phase: 0.3,
+                offset: 0.0,
+            },
+        ];
+        for spec in &specs {
+            let build = || Reference::build(spec, "x", 0.5, 3, Path::new("."), false).unwrap();
+            let (mut fused, mut separate) = (build(), build());
+            // Steps of 0.5 ms landing on the switches at 0.1 s and 0.1005 s, then uneven ones
+            // that land on the one at 0.25 s every other step.
+            let mut t0 = 0u64;
+            for k in 0..700u64 {
+                let t1 = t0
+                    + match k {
+                        0..400 => 500_000,
+                        _ if k % 2 == 0 => 300_000,
+                        _ => 200_000,
+                    };
+                let (a, b) = (t0 as f64, t1 as f64);
+                let want = [
+                    separate.value(a),
+                    separate.value(0.5 * (a + b)),
+                    separate.value_before(b),
+                ];
+                let got = fused.step_values(a, b);
+                assert_eq!(
+                    got.map(f64::to_bits),
+                    want.map(f64::to_bits),
+                    "{spec:?} at {t0}"
+                );
+                // The value at the step's end, as the bench samples it.
+                assert_eq!(fused.value(b).to_bits(), separate.value(b).to_bits());
+                t0 = t1;
+            }
+        }
+    }
 
     #[test]
     fn polynomial_derivatives_are_exact() {

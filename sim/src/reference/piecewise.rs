@@ -180,12 +180,7 @@ impl Piecewise {
     fn segment_at(&mut self, t_ns: f64) -> Segment {
         // Fast path: time moves forward in small steps, so the cursor's segment usually holds.
         let here = self.segments[self.cursor];
-        let next_start = match self.segments.get(self.cursor + 1) {
-            Some(next) => next.start_ns as f64,
-            None if matches!(self.generator, Generator::Done) => f64::INFINITY,
-            None => self.end_ns as f64,
-        };
-        if here.start_ns as f64 <= t_ns && t_ns < next_start {
+        if here.start_ns as f64 <= t_ns && t_ns < self.next_start() {
             return here;
         }
         while !matches!(self.generator, Generator::Done) && self.end_ns as f64 <= t_ns {
@@ -202,6 +197,33 @@ impl Piecewise {
             self.cursor -= 1;
         }
         self.segments[self.cursor]
+    }
+
+    /// Where the cursor's segment ends (as far as it is generated yet).
+    fn next_start(&self) -> f64 {
+        match self.segments.get(self.cursor + 1) {
+            Some(next) => next.start_ns as f64,
+            None if matches!(self.generator, Generator::Done) => f64::INFINITY,
+            None => self.end_ns as f64,
+        }
+    }
+
+    /// `[value(t0), value(tm), value_before(t1)]` for `t0 ≤ tm ≤ t1`, `t0 < t1`, when one
+    /// segment covers `[t0, t1]` (then the last is `value(t1)` too); `None` when a segment
+    /// starts in `(t0, t1]`. `at_t0` is `value(t0)` if the caller knows it.
+    pub(super) fn span_values(
+        &mut self,
+        t0: f64,
+        tm: f64,
+        t1: f64,
+        at_t0: Option<f64>,
+    ) -> Option<[f64; 3]> {
+        let seg = self.segment_at(t0);
+        if t1 >= self.next_start() {
+            return None;
+        }
+        let value = |t: f64| Self::evaluate(seg, t)[0];
+        Some([at_t0.unwrap_or_else(|| value(t0)), value(tm), value(t1)])
     }
 
     pub(super) fn value(&mut self, t_ns: f64) -> f64 {
