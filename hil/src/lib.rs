@@ -21,5 +21,6 @@ pub mod bus;
 pub mod dut;
 pub mod hitl;
 pub mod loopback;
+pub mod realtime;
 pub mod stream;
 pub mod vfc;

@@ -12,6 +12,7 @@
 //! side is an ordinary [`Session`] on the other end; it checks the
 //! device's own Served reports against its prediction.
 
+use crate::realtime::{self, Realtime, SystemScheduler};
 use crate::stream::{Session, StreamConfig, StreamError, Summary};
 use margemu_firmware::link::{Counters, Device};
 use margemu_protocol::link::DeviceState;
@@ -80,10 +81,25 @@ pub fn run(
 ) -> Result<(Result<Summary, StreamError>, DeviceReport), StreamError> {
     let port_err = |e: serialport::Error| StreamError::Port { source: e.into() };
     let (host, device) = TTYPort::pair().map_err(port_err)?;
+    let realtime = config.realtime;
     let session = Session::new(scene, config, dir)?;
-    let device = spawn_device(device).map_err(|source| StreamError::Port { source })?;
+    let device =
+        spawn_device_at(device, realtime).map_err(|source| StreamError::Port { source })?;
     let result = session.run_on_port(host, |_| {});
     Ok((result, device.stop()))
+}
+
+/// [`spawn_device`] with the device's thread at `realtime` ([`crate::realtime`]): it stands in
+/// for a board, which no other work on the host can hold up, so a benchmark of the host's
+/// pacing under load does not measure the device's thread being starved instead.
+fn spawn_device_at(port: TTYPort, realtime: Realtime) -> std::io::Result<LoopbackDevice> {
+    spawn_device_with_local(port, move || {
+        let (guard, _) = realtime::enter(realtime, Arc::new(SystemScheduler));
+        move |_: &mut Firmware, _: u64| {
+            let _in_this_thread = &guard;
+            ControlFlow::Continue(())
+        }
+    })
 }
 
 /// Runs the firmware's [`Device`] on `port` (one end of a pseudo-terminal pair) until stopped.

@@ -18,7 +18,7 @@
 #![warn(missing_docs)]
 
 pub use margemu_eval::{analysis, evaluate, frame, offline, tune};
-pub use margemu_hil::{bus, dut, hitl, loopback, stream, vfc};
+pub use margemu_hil::{bus, dut, hitl, loopback, realtime, stream, vfc};
 pub use margemu_sim::{
     bench, csv_column, filter_params, guard, input_file, marg, mcap, meta, motion, output, quat,
     reference, run, rundir, sampling, scene, truth,

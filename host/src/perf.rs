@@ -8,9 +8,13 @@
 //! - [`stream_sweep`]: scenes streamed in real time through a PTY pair to the firmware's link
 //!   handler at several rates, in both source modes: samples sent, served byte for byte, lost,
 //!   pacing jitter, link efficiency measured on the batches written;
+//!   optionally with CPU hogs running ([`hogs`]) and the pacing thread at real-time priority;
 //! - [`link_table`]: worst-case link efficiency of image and kinematics batches, and the rates a
 //!   UART carries.
 
+pub mod hogs;
+
+use margemu_hil::realtime::{Obtained, Realtime};
 use margemu_hil::stream::{JitterStats, ServedStats, SourceMode, StreamConfig};
 use margemu_model::time::nanos_from_seconds;
 use margemu_sim::reference::ReferenceError;
@@ -161,8 +165,22 @@ pub struct StreamRow {
     pub lead: Duration,
     /// Items per batch.
     pub batch: u64,
+    /// CPU hogs running during the row ([`hogs::Hogs`]).
+    pub hogs: usize,
+    /// The real-time pacing asked for and obtained.
+    pub pacing: Obtained,
     /// The session's error, if it ended early.
     pub error: Option<String>,
+}
+
+/// The conditions of a streaming row: the CPU hogs running meanwhile and the pacing thread's
+/// real-time request.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StreamLoad {
+    /// CPU-bound hog threads at normal priority, started before the row and stopped after it.
+    pub hogs: usize,
+    /// What the pacing thread asks for.
+    pub realtime: Realtime,
 }
 
 /// A kinematic scene with noise on every sensor (so consecutive images differ), `seconds` long
@@ -204,13 +222,14 @@ pub enum Streamed {
     Rig,
 }
 
-/// Streams [`stream_scene`] (with `what`) at each rate and source through the loopback device,
-/// writing each session's logs under `dir`.
+/// Streams [`stream_scene`] (with `what`) at each rate and source through the loopback device
+/// under `load`, writing each session's logs under `dir`.
 pub fn stream_sweep(
     what: Streamed,
     rates: &[f64],
     sources: &[SourceMode],
     seconds: f64,
+    load: StreamLoad,
     dir: &std::path::Path,
 ) -> Result<Vec<StreamRow>, margemu_hil::stream::StreamError> {
     let mut rows = Vec::new();
@@ -233,10 +252,22 @@ pub fn stream_sweep(
             let config = StreamConfig {
                 port: "pty".into(),
                 source,
+                realtime: load.realtime,
                 ..StreamConfig::default()
             };
-            let session_dir = dir.join(format!("{mode}-{rate_hz}"));
-            let (result, device) = margemu_hil::loopback::run(&scene, config, &session_dir)?;
+            let session_dir = match load == StreamLoad::default() {
+                true => dir.join(format!("{mode}-{rate_hz}")),
+                false => dir.join(format!(
+                    "{mode}-{rate_hz}-hogs{}-rt-{}",
+                    load.hogs, load.realtime
+                )),
+            };
+            let hogs = hogs::Hogs::start(load.hogs)
+                .map_err(|source| margemu_hil::stream::StreamError::Port { source })?;
+            hogs.wait_running();
+            let run = margemu_hil::loopback::run(&scene, config, &session_dir);
+            hogs.stop();
+            let (result, device) = run?;
             let summary = result.as_ref().ok();
             rows.push(StreamRow {
                 rate_hz,
@@ -251,6 +282,8 @@ pub fn stream_sweep(
                 efficiency: summary.map_or(0.0, |s| s.link.efficiency()),
                 lead: summary.map_or(Duration::ZERO, |s| s.lead),
                 batch: summary.map_or(0, |s| s.batch),
+                hogs: load.hogs,
+                pacing: summary.map_or_else(Obtained::default, |s| s.pacing.clone()),
                 error: result
                     .err()
                     .map(|e| format!("{e} (the device loop ended: {})", device.ended)),

@@ -57,6 +57,9 @@ pub struct HitlConfig {
     pub gauss_per_unit: f64,
     /// Host time between opening the session and scene time 0 (ns).
     pub start_delay_ns: u64,
+    /// Real-time pacing of the thread that runs the session ([`crate::realtime`]; off by
+    /// default, the command line's default is auto).
+    pub realtime: crate::realtime::Realtime,
 }
 
 impl Default for HitlConfig {
@@ -70,6 +73,7 @@ impl Default for HitlConfig {
             },
             gauss_per_unit: message::DEFAULT_GAUSS_PER_UNIT,
             start_delay_ns: 20_000_000,
+            realtime: crate::realtime::Realtime::Off,
         }
     }
 }

@@ -12,13 +12,14 @@
 //! | `meta.toml` | a session's ([`margemu_sim::meta::SessionMeta`]) with `source = "hil_sensor"`, `port` the port's path or `udp:HOST:PORT`, `baud` (0 for UDP), `mag_ut_per_unit` = 100 × gauss per unit; the `[chip]` table describes the scene's chip, which is not emulated; `[dut]` and `[completion]` appended at the end |
 //! | `truth.csv` | as `simulate` writes it, one row per sample sent |
 //! | `hil_sensor.csv` | [`HIL_SENSOR_COLUMNS`]: sample index, scene time, when its write returned (`send_ns`) and how late that was against `start_host_ns + t_ns` (`late_ns`), then every field as sent (`f32`, shortest round trip) and `fields_updated` in decimal |
-//! | `events.csv` | `host_ns,event,detail`: `start` (`start_host_ns N; …`, scene time 0), `end` (`completed`, `interrupted` or `error: …`), then the reader's `dut` row |
+//! | `events.csv` | `host_ns,event,detail`: `pacing` (the real-time pacing obtained, [`crate::realtime`]), `start` (`start_host_ns N; …`, scene time 0), `end` (`completed`, `interrupted` or `error: …`), then the reader's `dut` row |
 //! | `dut_*.csv` | the flight controller's replies ([`crate::dut`]) |
 
 use super::message::{gauss_per_unit, heartbeat, SensorMapping, GAUSS_PER_MICROTESLA};
 use super::pace::Pacer;
 use super::{HitlConfig, HitlError};
 use crate::dut::mavlink_out::MavlinkWriter;
+use crate::realtime::{self, Obtained, Realtime, SystemScheduler};
 use crate::stream::images::ImageSettings;
 use crate::stream::log::EVENTS_FILE;
 use crate::stream::{rate_of, StreamConfig};
@@ -33,6 +34,7 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// `hil_sensor.csv`.
 pub const HIL_SENSOR_FILE: &str = "hil_sensor.csv";
@@ -73,6 +75,7 @@ pub struct HitlSession<'a> {
     dir: PathBuf,
     mapping: SensorMapping,
     start_delay_ns: u64,
+    realtime: Realtime,
     completion: CompletionRecord,
 }
 
@@ -89,6 +92,8 @@ pub struct HitlSummary {
     pub start_host_ns: u64,
     /// The latest write against its instant (ns; 0 if none was late).
     pub max_late_ns: u64,
+    /// The real-time pacing obtained (`events.csv`'s `pacing` row).
+    pub pacing: Obtained,
 }
 
 impl<'a> HitlSession<'a> {
@@ -135,6 +140,7 @@ impl<'a> HitlSession<'a> {
             dir: dir.to_path_buf(),
             mapping,
             start_delay_ns: config.start_delay_ns,
+            realtime: config.realtime,
             completion: CompletionRecord::new(dir),
         })
     }
@@ -148,7 +154,8 @@ impl<'a> HitlSession<'a> {
     /// Sends the whole scene to `wire`: scene time 0 is `start_delay_ns` after now on `pacer`.
     /// Stops early when `stop` is set (interrupted), and on a write error. Every file is closed
     /// and the completion record updated (and written, unless a reader shares it) however it
-    /// ends.
+    /// ends. The calling thread paces the run at [`HitlConfig::realtime`] (put back at the end;
+    /// what it obtained is `events.csv`'s `pacing` row and [`HitlSummary::pacing`]).
     pub fn run<W: Write, P: Pacer>(
         self,
         wire: W,
@@ -160,8 +167,11 @@ impl<'a> HitlSession<'a> {
             dir,
             mapping,
             start_delay_ns,
+            realtime,
             completion,
         } = self;
+        let (guard, pacing) = realtime::enter(realtime, Arc::new(SystemScheduler));
+        realtime::warn_once(&pacing);
         let mut files = Files::create(&dir)?;
         let start = pacer.now_ns() + start_delay_ns;
         let mut sender = Sender {
@@ -182,8 +192,12 @@ impl<'a> HitlSession<'a> {
             scene.samples(),
             scene.clock.hz()
         );
+        let obtained = pacing.to_string().replace(',', ";");
+        events(&mut files, pacer.now_ns(), "pacing", &obtained)?;
+        sender.summary.pacing = pacing;
         events(&mut files, pacer.now_ns(), "start", &detail)?;
         let outcome = send_all(scene, &mapping, &mut files, &mut sender, pacer, stop);
+        drop(guard);
         let (status, ended) = match &outcome {
             Ok(()) => (Status::Complete, "completed".to_string()),
             Err(HitlError::Run(RunError::Interrupted)) => {

@@ -426,6 +426,7 @@ impl<L: Port, P: FnMut(&Progress)> Run<L, P> {
             link: self.pacing.link(),
             image_settings: *self.session.image_settings(),
             elapsed: self.elapsed(),
+            pacing: Default::default(),
         }
     }
 

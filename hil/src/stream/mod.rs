@@ -334,6 +334,8 @@ pub struct Summary {
     pub image_settings: ImageSettings,
     /// Time from Start to the end.
     pub elapsed: Duration,
+    /// The real-time pacing obtained ([`crate::realtime`]).
+    pub pacing: crate::realtime::Obtained,
 }
 
 /// Worst-case wire bytes of a batch frame of `n` items of `item_len` bytes each behind a batch

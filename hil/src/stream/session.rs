@@ -17,6 +17,7 @@ use super::port::{Port, SystemPort};
 use super::served::ServedCheck;
 use super::source::{Items, Prediction, Source};
 use super::{Progress, StreamError, Summary};
+use crate::realtime::{self, Realtime, Scheduler, SystemScheduler};
 use margemu_firmware::budget::Load;
 use margemu_protocol::link::{Configure, Encoder, HelloAck, Rate};
 use margemu_sim::rundir::{Completion, CompletionRecord, Status};
@@ -81,6 +82,9 @@ pub struct StreamConfig {
     /// Source mode (b) on a real board: which board, and whether to stream beyond its budget
     /// ([`budget`](super::budget)).
     pub budget: BudgetPolicy,
+    /// Real-time pacing of the thread that runs the session ([`crate::realtime`]; off by
+    /// default, the command line's default is auto).
+    pub realtime: Realtime,
 }
 
 impl Default for StreamConfig {
@@ -101,6 +105,7 @@ impl Default for StreamConfig {
             resend_after: Duration::from_millis(20),
             mcap: false,
             budget: BudgetPolicy::default(),
+            realtime: Realtime::Off,
         }
     }
 }
@@ -120,6 +125,8 @@ pub struct Session {
     origin: Option<Instant>,
     /// Source mode (b): what the device runs per output sample, and the output rate, Hz.
     load: Option<(Load, f64)>,
+    /// How [`StreamConfig::realtime`] is applied.
+    scheduler: Arc<dyn Scheduler>,
 }
 
 impl Session {
@@ -197,6 +204,7 @@ impl Session {
             stop: Arc::new(AtomicBool::new(false)),
             origin: None,
             load,
+            scheduler: Arc::new(SystemScheduler),
         })
     }
 
@@ -211,6 +219,12 @@ impl Session {
     /// [`crate::dut`]) can share the session's clock.
     pub fn set_origin(&mut self, origin: Instant) {
         self.origin = Some(origin);
+    }
+
+    /// Applies [`StreamConfig::realtime`] through `scheduler` instead of the operating
+    /// system's ([`SystemScheduler`]): a test makes it refuse.
+    pub fn set_scheduler(&mut self, scheduler: Arc<dyn Scheduler>) {
+        self.scheduler = scheduler;
     }
 
     /// A handle the device under test's reader writes its attitude into `session.mcap` with;
@@ -382,15 +396,29 @@ impl Session {
     /// [`Session::run`] on any [`Port`]: every host time the session waits for or logs comes
     /// from the port's clock (e.g. a [`VirtualPort`](super::virtual_port::VirtualPort) on a
     /// virtual clock). The port is dropped before the logs are closed.
+    ///
+    /// The calling thread paces the run: it asks for [`StreamConfig::realtime`] once the port
+    /// (and its receive thread) exists, and is put back when the run ends; what it obtained is
+    /// `events.csv`'s `pacing` row and [`Summary::pacing`], and a refusal is one warning line
+    /// on standard error ([`crate::realtime::warn_once`]).
     pub fn run_with(
-        self,
+        mut self,
         port: impl Port,
         progress: impl FnMut(&Progress),
     ) -> Result<Summary, StreamError> {
+        let (guard, pacing) = realtime::enter(self.config.realtime, self.scheduler.clone());
+        realtime::warn_once(&pacing);
+        if pacing.fifo_priority.is_some() {
+            self.config.spin = self.config.spin.min(realtime::MAX_SPIN);
+        }
+        let detail = pacing.to_string();
+        let logged = self.log.queue(move |log| log.event(0, "pacing", &detail));
         let mut run = Run::new(self, port, progress);
-        let result = run.session_flow();
+        let result = logged.and_then(|()| run.session_flow());
+        drop(guard);
         let end_ns = run.now() as i64;
-        let summary = run.summary();
+        let mut summary = run.summary();
+        summary.pacing = pacing;
         let mut log = run.into_logger(); // the port is dropped here
         let (status, ended) = match &result {
             Ok(()) => (Status::Complete, "completed".to_string()),

@@ -1,7 +1,8 @@
 //! `margemu bench stream`: streaming speed against error, measured here and now.
 
 use anyhow::Result;
-use margemu::perf::{link_table, stream_sweep, StreamRow, Streamed};
+use margemu::perf::{link_table, stream_sweep, StreamLoad, StreamRow, Streamed};
+use margemu::realtime::Realtime;
 use margemu::stream::{JitterStats, SourceMode};
 use margemu_protocol::chip::ChipModel;
 use std::path::PathBuf;
@@ -31,6 +32,34 @@ pub struct Cmd {
     /// on I2C, 52-byte images (register images only; rates both IMUs have, up to 8 kHz).
     #[arg(long, conflicts_with = "chip")]
     rig: bool,
+    /// Also stream every row with N CPU-bound hog threads at normal priority running (2 if N
+    /// is left out), and each of those with the pacing thread at normal priority and at
+    /// `--realtime`: four rows per rate and source.
+    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "2")]
+    loaded: Option<usize>,
+    #[command(flatten)]
+    realtime: super::stream::RealtimeArgs,
+}
+
+impl Cmd {
+    /// The conditions each rate and source is streamed under.
+    fn loads(&self) -> Vec<StreamLoad> {
+        let asked = self.realtime.realtime;
+        match self.loaded {
+            None => vec![StreamLoad {
+                hogs: 0,
+                realtime: asked,
+            }],
+            Some(n) => [0, n]
+                .into_iter()
+                .flat_map(|hogs| {
+                    [Realtime::Off, asked]
+                        .into_iter()
+                        .map(move |realtime| StreamLoad { hogs, realtime })
+                })
+                .collect(),
+        }
+    }
 }
 
 impl Cmd {
@@ -79,24 +108,28 @@ impl Cmd {
              samples), and checks the CRC-32C of every image it served against the host's \
              prediction. Lost = scene samples not served byte for byte (underruns, mismatches, \
              unreported). Pacing: how late each batch's write started against the scene clock; \
-             written: how late it completed (the PTY write included).\n",
+             written: how late it completed (the PTY write included). Hogs: CPU-bound threads at \
+             normal priority running meanwhile; pacing thread: the real-time priority the \
+             session obtained.\n",
             self.seconds,
             margemu::loopback::BUFFER,
         );
         println!(
-            "| source | rate (Hz) | samples | sent | served byte-exact | lost | of which mismatched | lead (ms) | batch | pacing late p50 / p99 / max (µs) | written late p50 / p99 / max (µs) | credit stalls | resends | link efficiency |"
+            "| source | rate (Hz) | hogs | pacing thread | samples | sent | served byte-exact | lost | of which mismatched | lead (ms) | batch | pacing late p50 / p99 / max (µs) | written late p50 / p99 / max (µs) | credit stalls | resends | link efficiency |"
         );
-        println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         let dir = self.keep.clone().unwrap_or_else(|| {
             std::env::temp_dir().join(format!("margemu-bench-stream-{}", std::process::id()))
         });
         for &source in &sources {
             for &rate in &self.rates {
-                let row = stream_sweep(what, &[rate], &[source], self.seconds, &dir)?;
-                if self.keep.is_none() {
-                    std::fs::remove_dir_all(&dir)?;
+                for load in self.loads() {
+                    let row = stream_sweep(what, &[rate], &[source], self.seconds, load, &dir)?;
+                    if self.keep.is_none() {
+                        std::fs::remove_dir_all(&dir)?;
+                    }
+                    row.iter().for_each(print_row);
                 }
-                row.iter().for_each(print_row);
             }
         }
         println!(
@@ -146,8 +179,10 @@ fn print_row(r: &StreamRow) {
         format!("{a:.1} / {b:.1} / {c:.1}")
     };
     println!(
-        "| {source} | {} | {} | {} | {} | {} | {} | {:.0} | {} | {} | {} | {} | {} | {:.1} % |{}",
+        "| {source} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {} | {} | {} | {} | {} | {:.1} % |{}",
         r.rate_hz,
+        r.hogs,
+        r.pacing,
         r.samples,
         r.sent,
         s.byte_exact,

@@ -49,6 +49,8 @@ pub struct Cmd {
     output: super::OutputArgs,
     #[command(flatten)]
     size: super::SizeArgs,
+    #[command(flatten)]
+    realtime: super::stream::RealtimeArgs,
 }
 
 impl Cmd {
@@ -76,6 +78,7 @@ impl Cmd {
         let config = HitlConfig {
             target: target.clone(),
             gauss_per_unit: self.gauss_per_unit,
+            realtime: self.realtime.realtime,
             ..HitlConfig::default()
         };
         // Checks the scene and the link before anything is written.

@@ -33,6 +33,8 @@ pub struct Cmd {
     /// Also write `session.mcap` (ROS 2 messages for Foxglove and `ros2 bag`; docs/mcap.md).
     #[arg(long)]
     mcap: bool,
+    #[command(flatten)]
+    realtime: super::stream::RealtimeArgs,
 }
 
 impl Cmd {
@@ -56,6 +58,7 @@ impl Cmd {
             source: self.source.mode()?,
             budget: self.source.budget().in_process(),
             mcap: self.mcap,
+            realtime: self.realtime.realtime,
             ..StreamConfig::default()
         };
         let mut session = prepare(&scene, config, &dir)?;

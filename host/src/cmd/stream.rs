@@ -46,6 +46,17 @@ pub struct Cmd {
     /// Also write `session.mcap` (ROS 2 messages for Foxglove and `ros2 bag`; docs/mcap.md).
     #[arg(long)]
     mcap: bool,
+    #[command(flatten)]
+    realtime: RealtimeArgs,
+}
+
+/// Real-time pacing of the thread that writes to the device (`margemu::realtime`).
+#[derive(clap::Args)]
+pub struct RealtimeArgs {
+    /// `off`, `auto` (SCHED_FIFO priority 10 and memory locked where permitted; otherwise one
+    /// warning and normal priority) or a SCHED_FIFO priority from 1 to 99.
+    #[arg(long, value_name = "off|auto|PRIO", default_value = "auto")]
+    pub realtime: margemu::realtime::Realtime,
 }
 
 /// Which chip the device emulates.
@@ -196,6 +207,7 @@ impl Cmd {
             batch,
             resend_after: resend_after(batch, self.baud),
             mcap: self.mcap,
+            realtime: self.realtime.realtime,
             ..StreamConfig::default()
         };
         let port =
@@ -295,8 +307,9 @@ pub fn stream_to(
     );
     let j = summary.jitter;
     println!(
-        "pacing jitter over {} batches: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; logs in {}",
+        "pacing jitter over {} batches ({}): p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs; logs in {}",
         j.batches,
+        summary.pacing,
         j.p50_ns as f64 / 1e3,
         j.p99_ns as f64 / 1e3,
         j.max_ns as f64 / 1e3,
