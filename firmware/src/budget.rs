@@ -148,25 +148,9 @@ impl Load {
     /// vibration sources that move it.
     pub fn with_chain(mut self, setup: &ChainSetup, front: Option<&ModelFront>) -> Self {
         let [accel_ns, gyro_ns] = front.map_or([0, 0], internal_periods_ns);
-        let sensor = |sense: Sense, period_ns: u64| {
-            let tones: usize = setup
-                .tones
-                .iter()
-                .filter(|t| t.moves(sense))
-                .map(|t| usize::from(t.motors) * t.harmonics().len())
-                .sum();
-            let shocks = setup
-                .shocks
-                .iter()
-                .filter(|s| match sense {
-                    Sense::Linear => s.linear != [0.0; 3],
-                    Sense::Angular => s.angular != [0.0; 3],
-                })
-                .count();
-            SensorLoad {
-                internal_period_ns: (period_ns != 0).then_some(period_ns),
-                sources: tones + shocks,
-            }
+        let sensor = |sense: Sense, period_ns: u64| SensorLoad {
+            internal_period_ns: (period_ns != 0).then_some(period_ns),
+            sources: setup.sources_moving(sense),
         };
         self.accel = sensor(Sense::Linear, accel_ns);
         self.gyro = sensor(Sense::Angular, gyro_ns);
@@ -217,6 +201,10 @@ pub struct Board {
     /// Its core clock, Hz.
     pub core_hz: f64,
 }
+
+/// The device ID the QEMU board reports in HelloAck (zero-padded; QEMU's MPS2 has no unique ID):
+/// the host does not budget it (it is not real time on a fixed clock).
+pub const QEMU_DEVICE_ID: &[u8] = b"qemu-mps2-an386";
 
 /// The WeAct Black Pill (STM32F411CEU6, Cortex-M4F) at 96 MHz (`docs/boards/blackpill-f411.md`).
 pub const BLACKPILL_F411: Board = Board {

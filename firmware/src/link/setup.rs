@@ -7,7 +7,7 @@ use margemu_model::chain::{Clipper, DeviceChain};
 use margemu_model::fault::{Fault, ScheduleFull, SensorFaults};
 use margemu_model::perturbation::Complex;
 use margemu_model::sensor::{Marg, Truth};
-use margemu_model::vibration::{Shock, ToneSource, MAX_SHOCKS, MAX_TONE_SOURCES};
+use margemu_model::vibration::{Sense, Shock, ToneSource, MAX_SHOCKS, MAX_TONE_SOURCES};
 use margemu_protocol::chip::chain::ChainConfig;
 use margemu_protocol::chip::{ChipSettings, PhysicalSample};
 use margemu_protocol::link::{
@@ -55,6 +55,26 @@ pub struct ChainSetup {
 }
 
 impl ChainSetup {
+    /// The vibration sources that move `sense`: each tone source's motors × harmonics, and
+    /// each shock with a non-zero part on that sense (the unit both cost models count in).
+    pub fn sources_moving(&self, sense: Sense) -> usize {
+        let tones: usize = self
+            .tones
+            .iter()
+            .filter(|t| t.moves(sense))
+            .map(|t| usize::from(t.motors) * t.harmonics().len())
+            .sum();
+        let shocks = self
+            .shocks
+            .iter()
+            .filter(|s| match sense {
+                Sense::Linear => s.linear != [0.0; 3],
+                Sense::Angular => s.angular != [0.0; 3],
+            })
+            .count();
+        tones + shocks
+    }
+
     /// Adds one piece; `false` (nothing changed) if it does not fit.
     pub fn add(&mut self, piece: &AddVibration) -> bool {
         match piece {

@@ -32,8 +32,7 @@ use margemu_sim::scene::Scene;
 use super::model::{device_chip, model_chain_setup};
 use super::StreamError;
 
-/// The device ID the QEMU board reports (zero-padded).
-pub const QEMU_DEVICE_ID: &[u8] = b"qemu-mps2-an386";
+pub use margemu_firmware::budget::QEMU_DEVICE_ID;
 
 /// What the device is, for the budget (`--board`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

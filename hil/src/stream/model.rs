@@ -288,21 +288,7 @@ pub fn chain_cost(setup: &ChainSetup, chain: &ModelFront, rate: Rate) -> f64 {
             0 => (1.0, COST_OUTPUT_STEP),
             p => (out_ns / p as f64, COST_FILTER_STEP),
         };
-        let tones: usize = setup
-            .tones
-            .iter()
-            .filter(|t| t.moves(sense))
-            .map(|t| usize::from(t.motors) * t.harmonics().len())
-            .sum();
-        let shocks = setup
-            .shocks
-            .iter()
-            .filter(|s| match sense {
-                Sense::Linear => s.linear != [0.0; 3],
-                Sense::Angular => s.angular != [0.0; 3],
-            })
-            .count();
-        samples * (step + COST_TONE * (tones + shocks) as f64)
+        samples * (step + COST_TONE * setup.sources_moving(sense) as f64)
     };
     let (accel_ns, gyro_ns) = match chain {
         Front::Clip(_) => (0, 0),

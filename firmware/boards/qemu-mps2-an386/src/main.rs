@@ -110,7 +110,7 @@ fn sleep_until_work(serial: &Serial) {
 fn identity() -> Identity {
     let part = |s: &str| s.parse().unwrap_or(0);
     let mut device_id = [0u8; DEVICE_ID_LEN];
-    let name = b"qemu-mps2-an386";
+    let name = margemu_firmware::budget::QEMU_DEVICE_ID;
     device_id[..name.len()].copy_from_slice(name);
     Identity {
         firmware: FirmwareVersion {
